@@ -1,0 +1,24 @@
+//! ballpit: circles colliding in a box.
+//!
+//! - [`sim`]: the headless simulation plugin, runnable under `MinimalPlugins`; its stages are
+//!   movement → collision → response, in `FixedUpdate`.
+//! - [`headless`]: step a scene without a window and measure it.
+//! - [`render`]: drawing the simulation in a window (reads its state only).
+//! - [`play`]: the windowed toy.
+//! - [`cli`]: the `ballpit` command line.
+
+pub mod cli;
+pub mod headless;
+pub mod play;
+pub mod render;
+pub mod sim;
+
+/// The types most users of the crate need.
+pub mod prelude {
+    pub use crate::headless::{RunReport, headless_app, run_scene};
+    pub use crate::sim::{
+        Ball, BallCollision, BallId, BallState, BroadPhase, MassModel, Position, Radius, SceneFile,
+        SceneSetup, SimParams, SimPlugin, SimStats, SimSystems, StateSummary, Velocity, Wall,
+        WallCollision,
+    };
+}

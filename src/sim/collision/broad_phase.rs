@@ -1,0 +1,194 @@
+//! Broad phase: which pairs of balls might touch, before the exact test.
+//!
+//! Runs inside [`detect_contacts`](super::detect_contacts). Two methods find the same pairs:
+//! [`UniformGrid`], O(N), the default, and [`for_each_pair`], O(N^2), kept as the reference the
+//! grid is tested against.
+
+use bevy::math::DVec2;
+
+use super::narrow_phase::Circle;
+
+/// The grid never has more cells than this many per ball, so a few tiny balls in a huge
+/// arena cost little memory; the cells grow instead.
+const MAX_CELLS_PER_BALL: usize = 4;
+
+/// Neighbour cells visited from each cell, as (column, row) offsets. With the cell's own
+/// contents these four "forward" neighbours reach every adjacent cell pair exactly once.
+const FORWARD_NEIGHBOURS: [(isize, isize); 4] = [(1, 0), (-1, 1), (0, 1), (1, 1)];
+
+/// A uniform grid over the balls' centres, rebuilt from scratch every step by a counting sort.
+///
+/// The cell side is at least the largest diameter, so two touching circles always sit in the
+/// same or in adjacent cells. The buffers are kept between steps to avoid reallocating.
+#[derive(Debug, Default)]
+pub struct UniformGrid {
+    origin: DVec2,
+    cell_size: f64,
+    columns: usize,
+    rows: usize,
+    /// `cell_start[c]..cell_start[c + 1]` is cell `c`'s range in `sorted_*`.
+    cell_start: Vec<u32>,
+    /// Ball indices in cell order.
+    sorted_index: Vec<u32>,
+    /// The circles in cell order, so the pair loops read contiguous memory.
+    sorted_circle: Vec<Circle>,
+    cell_of: Vec<u32>,
+}
+
+impl UniformGrid {
+    /// Sorts `circles` into cells.
+    pub fn rebuild(&mut self, circles: &[Circle]) {
+        let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
+        for circle in circles {
+            min = min.min(circle.center);
+            max = max.max(circle.center);
+            largest_radius = largest_radius.max(circle.radius);
+        }
+        if circles.is_empty() {
+            (min, max) = (DVec2::ZERO, DVec2::ZERO);
+        }
+        let extent = max - min;
+        let max_cells = (circles.len() * MAX_CELLS_PER_BALL).max(1);
+        // Smallest cell that holds a diameter and keeps the cell count bounded.
+        let cell_size = (2.0 * largest_radius)
+            .max((extent.x * extent.y / max_cells as f64).sqrt())
+            .max(f64::MIN_POSITIVE);
+        self.origin = min;
+        self.cell_size = cell_size;
+        // The caps only bind for non-finite extents; clamping cells together never separates
+        // two touching balls by more than one cell, so no pair is lost.
+        self.columns = cells_along(extent.x, cell_size).min(max_cells);
+        self.rows = cells_along(extent.y, cell_size).min((max_cells / self.columns).max(1));
+        let cell_count = self.columns * self.rows;
+
+        self.cell_start.clear();
+        self.cell_start.resize(cell_count + 1, 0);
+        self.cell_of.clear();
+        for circle in circles {
+            let cell = self.cell_index(circle.center);
+            self.cell_of.push(cell as u32);
+            self.cell_start[cell + 1] += 1;
+        }
+        for cell in 0..cell_count {
+            self.cell_start[cell + 1] += self.cell_start[cell];
+        }
+        let mut cursor = self.cell_start.clone();
+        self.sorted_index.clear();
+        self.sorted_index.resize(circles.len(), 0);
+        self.sorted_circle.clear();
+        self.sorted_circle
+            .resize(circles.len(), Circle::new(DVec2::ZERO, 0.0));
+        for (index, (&cell, circle)) in self.cell_of.iter().zip(circles).enumerate() {
+            let slot = cursor[cell as usize] as usize;
+            cursor[cell as usize] += 1;
+            self.sorted_index[slot] = index as u32;
+            self.sorted_circle[slot] = *circle;
+        }
+    }
+
+    /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls in the same or
+    /// adjacent cells, in a fixed order (cell by cell, row-major). Indices are the positions
+    /// in the slice given to [`rebuild`](Self::rebuild).
+    pub fn for_each_candidate_pair(&self, mut visit: impl FnMut(u32, u32, Circle, Circle)) {
+        for row in 0..self.rows {
+            for column in 0..self.columns {
+                let here = self.cell_range(column as isize, row as isize);
+                for slot in here.clone() {
+                    let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
+                    for other in slot + 1..here.end {
+                        visit(index, self.sorted_index[other], circle, self.sorted_circle[other]);
+                    }
+                    for (dc, dr) in FORWARD_NEIGHBOURS {
+                        let there = self.cell_range(column as isize + dc, row as isize + dr);
+                        for other in there {
+                            visit(index, self.sorted_index[other], circle, self.sorted_circle[other]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn cell_index(&self, center: DVec2) -> usize {
+        // `as usize` saturates (and maps NaN to 0), so a stray value cannot index out of range.
+        let column = (((center.x - self.origin.x) / self.cell_size) as usize).min(self.columns - 1);
+        let row = (((center.y - self.origin.y) / self.cell_size) as usize).min(self.rows - 1);
+        row * self.columns + column
+    }
+
+    fn cell_range(&self, column: isize, row: isize) -> std::ops::Range<usize> {
+        if column < 0 || row < 0 || column as usize >= self.columns || row as usize >= self.rows {
+            return 0..0;
+        }
+        let cell = row as usize * self.columns + column as usize;
+        self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize
+    }
+}
+
+fn cells_along(extent: f64, cell_size: f64) -> usize {
+    // Saturating casts: a non-finite extent collapses to one cell rather than panicking.
+    ((extent / cell_size) as usize).saturating_add(1).max(1)
+}
+
+/// Calls `visit(i, j, circle_i, circle_j)` for every pair `i < j`: the O(N^2) reference.
+pub fn for_each_pair(circles: &[Circle], mut visit: impl FnMut(u32, u32, Circle, Circle)) {
+    for (i, &a) in circles.iter().enumerate() {
+        for (j, &b) in circles.iter().enumerate().skip(i + 1) {
+            visit(i as u32, j as u32, a, b);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_visits_each_nearby_pair_once() {
+        let circles: Vec<Circle> = (0..30)
+            .map(|i| Circle::new(DVec2::new((i % 6) as f64 * 7.0, (i / 6) as f64 * 7.0), 5.0))
+            .collect();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut seen = std::collections::HashSet::new();
+        grid.for_each_candidate_pair(|i, j, _, _| {
+            assert_ne!(i, j);
+            assert!(seen.insert((i.min(j), i.max(j))), "pair ({i}, {j}) visited twice");
+        });
+        // Every pair within one diameter must be among the candidates.
+        for_each_pair(&circles, |i, j, a, b| {
+            if a.center.distance(b.center) <= a.radius + b.radius {
+                assert!(seen.contains(&(i, j)), "grid missed pair ({i}, {j})");
+            }
+        });
+    }
+
+    #[test]
+    fn grid_survives_empty_single_and_non_finite_input() {
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&[]);
+        grid.for_each_candidate_pair(|_, _, _, _| panic!("no pairs in an empty grid"));
+        grid.rebuild(&[Circle::new(DVec2::ZERO, 1.0)]);
+        grid.for_each_candidate_pair(|_, _, _, _| panic!("no pairs with one ball"));
+        let strange = [
+            Circle::new(DVec2::new(f64::NAN, 0.0), 1.0),
+            Circle::new(DVec2::new(f64::INFINITY, 0.0), 1.0),
+            Circle::new(DVec2::ZERO, 1.0),
+        ];
+        grid.rebuild(&strange);
+        let mut pairs = 0;
+        grid.for_each_candidate_pair(|_, _, _, _| pairs += 1);
+        assert!(pairs <= 3);
+    }
+
+    #[test]
+    fn cell_count_stays_bounded_for_tiny_balls_far_apart() {
+        let circles = [
+            Circle::new(DVec2::new(-1.0e6, -1.0e6), 0.5),
+            Circle::new(DVec2::new(1.0e6, 1.0e6), 0.5),
+        ];
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        assert!(grid.columns * grid.rows <= 2 * MAX_CELLS_PER_BALL + 4);
+    }
+}

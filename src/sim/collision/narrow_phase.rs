@@ -1,0 +1,132 @@
+//! Narrow phase: the exact circle–circle tests, as pure functions over plain values.
+//!
+//! Runs inside [`detect_contacts`](super::detect_contacts) for every candidate pair the broad
+//! phase proposes, and again wherever a prediction must match the simulation exactly (tests,
+//! the aiming guide).
+
+use bevy::math::DVec2;
+
+/// A circle in arena coordinates (pixels).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    pub center: DVec2,
+    /// Pixels; always positive for a valid ball.
+    pub radius: f64,
+}
+
+impl Circle {
+    pub const fn new(center: DVec2, radius: f64) -> Self {
+        Self { center, radius }
+    }
+}
+
+/// Where and how deeply two circles touch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactGeometry {
+    /// Unit vector from the first circle's centre towards the second's.
+    pub normal: DVec2,
+    /// Overlap along the normal, pixels (`r1 + r2 - distance`); zero when just touching.
+    pub depth: f64,
+    /// The radius-weighted collision point `(p1*r2 + p2*r1) / (r1 + r2)`.
+    pub point: DVec2,
+}
+
+/// The cheap pre-check: do the circles' axis-aligned bounding boxes overlap (or touch)?
+#[inline]
+pub fn aabbs_overlap(a: Circle, b: Circle) -> bool {
+    let reach = a.radius + b.radius;
+    let d = (b.center - a.center).abs();
+    d.x <= reach && d.y <= reach
+}
+
+/// The tutorial's collision point, weighted by radius: `(p1*r2 + p2*r1) / (r1 + r2)`.
+///
+/// For two touching circles it is the point where they touch; for overlapping ones it lies on
+/// the line of centres, inside the lens, closer to the smaller circle's centre.
+#[inline]
+pub fn collision_point(a: Circle, b: Circle) -> DVec2 {
+    (a.center * b.radius + b.center * a.radius) / (a.radius + b.radius)
+}
+
+/// The unit normal used when two centres coincide and the line of centres is undefined.
+///
+/// Any fixed direction keeps the result finite and deterministic; separation then pushes the
+/// pair apart along it.
+pub const COINCIDENT_NORMAL: DVec2 = DVec2::X;
+
+/// The exact test: AABB first, then squared distance against `(r1 + r2)^2` (no square root
+/// unless the circles really touch). Returns `None` for circles that neither touch nor overlap.
+#[inline]
+pub fn circle_contact(a: Circle, b: Circle) -> Option<ContactGeometry> {
+    if !aabbs_overlap(a, b) {
+        return None;
+    }
+    let delta = b.center - a.center;
+    let reach = a.radius + b.radius;
+    let distance_squared = delta.length_squared();
+    if distance_squared > reach * reach {
+        return None;
+    }
+    let distance = distance_squared.sqrt();
+    let normal = if distance > 0.0 {
+        delta / distance
+    } else {
+        COINCIDENT_NORMAL
+    };
+    Some(ContactGeometry {
+        normal,
+        depth: reach - distance,
+        point: collision_point(a, b),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(x: f64, y: f64, r: f64) -> Circle {
+        Circle::new(DVec2::new(x, y), r)
+    }
+
+    #[test]
+    fn aabb_rejects_far_pairs_and_accepts_diagonal_near_misses() {
+        assert!(!aabbs_overlap(circle(0.0, 0.0, 1.0), circle(3.0, 0.0, 1.0)));
+        // Diagonal neighbours: boxes overlap, circles do not; the exact test must reject them.
+        let (a, b) = (circle(0.0, 0.0, 1.0), circle(1.6, 1.6, 1.0));
+        assert!(aabbs_overlap(a, b));
+        assert_eq!(circle_contact(a, b), None);
+    }
+
+    #[test]
+    fn collision_point_is_weighted_by_radius() {
+        // Touching circles: the point is where they touch.
+        let p = collision_point(circle(0.0, 0.0, 10.0), circle(30.0, 0.0, 20.0));
+        assert_eq!(p, DVec2::new(10.0, 0.0));
+        // Equal radii: the midpoint.
+        let p = collision_point(circle(-2.0, 4.0, 5.0), circle(2.0, 0.0, 5.0));
+        assert_eq!(p, DVec2::new(0.0, 2.0));
+    }
+
+    #[test]
+    fn contact_has_unit_normal_from_a_to_b_and_the_overlap_depth() {
+        let c = circle_contact(circle(0.0, 0.0, 10.0), circle(6.0, 8.0, 5.0)).unwrap();
+        assert!((c.normal - DVec2::new(0.6, 0.8)).length() < 1e-15);
+        assert!((c.depth - 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn touching_counts_as_contact_with_zero_depth() {
+        let c = circle_contact(circle(0.0, 0.0, 10.0), circle(20.0, 0.0, 10.0)).unwrap();
+        assert_eq!(c.depth, 0.0);
+        assert_eq!(c.point, DVec2::new(10.0, 0.0));
+        assert_eq!(circle_contact(circle(0.0, 0.0, 10.0), circle(20.001, 0.0, 10.0)), None);
+    }
+
+    #[test]
+    fn coincident_centres_give_a_finite_normal_and_full_depth() {
+        let c = circle_contact(circle(3.0, 3.0, 4.0), circle(3.0, 3.0, 6.0)).unwrap();
+        assert_eq!(c.normal, COINCIDENT_NORMAL);
+        assert_eq!(c.depth, 10.0);
+        assert!(c.point.is_finite());
+    }
+}

@@ -1,0 +1,56 @@
+//! Outward notices from the simulation: one [`BallCollision`] per ball–ball hit and one
+//! [`WallCollision`] per wall hit, written during the fixed step, for effects, counters and
+//! tests. Nothing inside the simulation's own stages depends on them.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use serde::Serialize;
+
+/// Two balls that were approaching along their line of centres and exchanged momentum.
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct BallCollision {
+    pub a: Entity,
+    pub b: Entity,
+    /// Radius-weighted collision point, pixels.
+    pub point: DVec2,
+    /// Unit vector from `a` towards `b`.
+    pub normal: DVec2,
+    /// Magnitude of the impulse along the normal, mass x pixels per second.
+    pub impulse: f64,
+    /// Speed at which the balls were closing along the normal, pixels per second.
+    pub normal_speed: f64,
+}
+
+/// The four sides of the arena.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub enum Wall {
+    Left,
+    Right,
+    Bottom,
+    Top,
+}
+
+impl Wall {
+    /// The wall's outward normal (pointing out of the arena).
+    pub fn outward_normal(self) -> DVec2 {
+        match self {
+            Wall::Left => DVec2::NEG_X,
+            Wall::Right => DVec2::X,
+            Wall::Bottom => DVec2::NEG_Y,
+            Wall::Top => DVec2::Y,
+        }
+    }
+}
+
+/// A ball that reached a wall while moving into it and bounced.
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct WallCollision {
+    pub ball: Entity,
+    pub wall: Wall,
+    /// Where the ball touched the wall, pixels.
+    pub point: DVec2,
+    /// Magnitude of the wall's impulse on the ball, mass x pixels per second.
+    pub impulse: f64,
+    /// Speed into the wall before the hit, pixels per second.
+    pub normal_speed: f64,
+}

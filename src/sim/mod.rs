@@ -1,0 +1,82 @@
+//! The headless simulation. Every plugin in this module works without rendering: it touches
+//! no window, asset, render or egui resource, so it runs under `MinimalPlugins` in tests, on
+//! the command line and in benchmarks exactly as it does in the game.
+//!
+//! One fixed step, in `FixedUpdate`, is four ordered sets (chained once, below):
+//!
+//! 1. [`SimSystems::Movement`]: integrate velocity and position; bounce off the walls.
+//! 2. [`SimSystems::Collision`]: broad phase (grid), AABB test, exact distance test → [`Contacts`].
+//! 3. [`SimSystems::Response`]: elastic exchange along each contact normal, separation, walls.
+//! 4. [`SimSystems::Bookkeeping`]: counters from the collision messages; debug invariants.
+//!
+//! Data flows one way: components → contacts → components, and outward as
+//! [`BallCollision`] / [`WallCollision`] messages.
+
+pub mod ball;
+pub mod collision;
+pub mod messages;
+pub mod movement;
+pub mod params;
+pub mod response;
+pub mod scene;
+pub mod stats;
+
+use bevy::prelude::*;
+
+pub use ball::{Ball, BallId, BallState, Position, Radius, Velocity};
+pub use collision::{Contact, Contacts};
+pub use messages::{BallCollision, Wall, WallCollision};
+pub use params::{BroadPhase, MassModel, SimParams};
+pub use scene::{SceneError, SceneFile, SceneSetup, SimRng};
+pub use stats::{SimStats, StateSummary};
+
+/// The simulation's stages, run in this order every fixed step.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SimSystems {
+    /// Integrate motion and keep balls inside the arena.
+    Movement,
+    /// Find touching pairs: broad phase, AABB test, exact test.
+    Collision,
+    /// Exchange momentum along contact normals and separate overlapping pairs.
+    Response,
+    /// Count steps and collisions; check invariants in debug builds.
+    Bookkeeping,
+}
+
+/// Adds the simulation: its resources, messages and the four ordered stages.
+pub struct SimPlugin;
+
+impl Plugin for SimPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SimParams>()
+            .add_message::<BallCollision>()
+            .add_message::<WallCollision>()
+            .configure_sets(
+                FixedUpdate,
+                (
+                    SimSystems::Movement,
+                    SimSystems::Collision,
+                    SimSystems::Response,
+                    SimSystems::Bookkeeping,
+                )
+                    .chain()
+                    .run_if(simulation_running),
+            )
+            .add_plugins((
+                movement::plugin,
+                collision::plugin,
+                response::plugin,
+                stats::plugin,
+                scene::plugin,
+            ));
+    }
+}
+
+fn simulation_running(params: Res<SimParams>) -> bool {
+    !params.paused
+}
+
+/// Simulated seconds in this fixed step: the fixed timestep scaled by `time_scale`.
+pub fn step_seconds(time: &Time, params: &SimParams) -> f64 {
+    time.delta_secs_f64() * params.time_scale
+}

@@ -1,0 +1,202 @@
+//! Stage 1, movement: integrate every ball's velocity and position over the step, then keep it
+//! in the arena by bouncing it off the walls.
+//!
+//! Runs in [`SimSystems::Movement`](super::SimSystems::Movement). The wall bounce is also run
+//! at the end of the response stage, because separating balls can push one into a wall.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::ball::{Ball, Position, Radius, Velocity};
+use super::messages::{Wall, WallCollision};
+use super::params::SimParams;
+use super::{SimSystems, step_seconds};
+
+pub(super) fn plugin(app: &mut App) {
+    app.add_systems(
+        FixedUpdate,
+        (integrate_motion, bounce_off_walls)
+            .chain()
+            .in_set(SimSystems::Movement),
+    );
+}
+
+/// A wall hit as plain values, before it becomes a [`WallCollision`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallHit {
+    pub wall: Wall,
+    /// Speed into the wall before the hit, pixels per second (positive).
+    pub normal_speed: f64,
+}
+
+/// The outcome of [`contain_in_arena`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contained {
+    pub position: DVec2,
+    pub velocity: DVec2,
+    /// At most one hit per axis (a corner gives two).
+    pub hits: [Option<WallHit>; 2],
+}
+
+/// Semi-implicit Euler with gravity and exponential damping over `dt` seconds.
+#[inline]
+pub fn integrate(position: DVec2, velocity: DVec2, gravity: DVec2, damping: f64, dt: f64) -> (DVec2, DVec2) {
+    let velocity = (velocity + gravity * dt) * (-damping * dt).exp();
+    (position + velocity * dt, velocity)
+}
+
+/// Puts a ball whose circle crosses a wall of the arena `[-half, half]` back inside.
+///
+/// A ball moving into the wall is mirrored back by the restitution-scaled overshoot and its
+/// normal velocity reflected and scaled by `restitution`; one already moving away (pushed out
+/// by a neighbour) is only moved back to the wall. A ball wider than the arena is centred on
+/// that axis and stopped along it.
+pub fn contain_in_arena(
+    mut position: DVec2,
+    mut velocity: DVec2,
+    radius: f64,
+    half: DVec2,
+    restitution: f64,
+) -> Contained {
+    let mut hits = [None, None];
+    for (axis, (low_wall, high_wall)) in [(Wall::Left, Wall::Right), (Wall::Bottom, Wall::Top)]
+        .into_iter()
+        .enumerate()
+    {
+        let limit = half[axis] - radius;
+        if limit <= 0.0 {
+            position[axis] = 0.0;
+            velocity[axis] = 0.0;
+            continue;
+        }
+        for (side, wall) in [(1.0, high_wall), (-1.0, low_wall)] {
+            let overshoot = side * position[axis] - limit;
+            if overshoot <= 0.0 {
+                continue;
+            }
+            let speed_into_wall = side * velocity[axis];
+            if speed_into_wall > 0.0 {
+                position[axis] = side * (limit - restitution * overshoot);
+                velocity[axis] = -side * restitution * speed_into_wall;
+                hits[axis] = Some(WallHit { wall, normal_speed: speed_into_wall });
+            }
+            position[axis] = position[axis].clamp(-limit, limit);
+        }
+    }
+    Contained { position, velocity, hits }
+}
+
+/// Where a ball of `radius` at `position` touches `wall` of the arena `[-half, half]`.
+pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
+    match wall {
+        Wall::Left => DVec2::new(-half.x, position.y),
+        Wall::Right => DVec2::new(half.x, position.y),
+        Wall::Bottom => DVec2::new(position.x, -half.y),
+        Wall::Top => DVec2::new(position.x, half.y),
+    }
+}
+
+fn integrate_motion(
+    time: Res<Time>,
+    params: Res<SimParams>,
+    mut balls: Query<(&mut Position, &mut Velocity), With<Ball>>,
+) {
+    let dt = step_seconds(&time, &params);
+    let (gravity, damping) = (params.gravity, params.linear_damping);
+    balls.par_iter_mut().for_each(|(mut position, mut velocity)| {
+        (position.0, velocity.0) = integrate(position.0, velocity.0, gravity, damping, dt);
+    });
+}
+
+/// Keeps every ball inside the arena, writing a [`WallCollision`] per bounce.
+pub(super) fn bounce_off_walls(
+    params: Res<SimParams>,
+    mut balls: Query<(Entity, &mut Position, &mut Velocity, &Radius), With<Ball>>,
+    mut wall_hits: MessageWriter<WallCollision>,
+) {
+    let half = params.half_extents();
+    for (ball, mut position, mut velocity, radius) in &mut balls {
+        let contained = contain_in_arena(position.0, velocity.0, radius.0, half, params.restitution);
+        if contained.position == position.0 && contained.velocity == velocity.0 {
+            continue;
+        }
+        (position.0, velocity.0) = (contained.position, contained.velocity);
+        for hit in contained.hits.into_iter().flatten() {
+            wall_hits.write(WallCollision {
+                ball,
+                wall: hit.wall,
+                point: wall_contact_point(hit.wall, position.0, half),
+                impulse: params.mass_model.mass(radius.0) * (1.0 + params.restitution) * hit.normal_speed,
+                normal_speed: hit.normal_speed,
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HALF: DVec2 = DVec2::new(100.0, 50.0);
+
+    #[test]
+    fn integration_applies_gravity_before_moving() {
+        let (p, v) = integrate(DVec2::ZERO, DVec2::new(10.0, 0.0), DVec2::new(0.0, -10.0), 0.0, 0.5);
+        assert_eq!(v, DVec2::new(10.0, -5.0));
+        assert_eq!(p, DVec2::new(5.0, -2.5));
+    }
+
+    #[test]
+    fn damping_decays_velocity_exponentially() {
+        let (_, v) = integrate(DVec2::ZERO, DVec2::new(8.0, 0.0), DVec2::ZERO, 2.0, 0.5);
+        assert!((v.x - 8.0 * (-1.0f64).exp()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn ball_past_the_right_wall_is_mirrored_back_and_reflected() {
+        let c = contain_in_arena(DVec2::new(95.0, 0.0), DVec2::new(30.0, 7.0), 10.0, HALF, 1.0);
+        assert_eq!(c.position, DVec2::new(85.0, 0.0));
+        assert_eq!(c.velocity, DVec2::new(-30.0, 7.0));
+        assert_eq!(c.hits, [Some(WallHit { wall: Wall::Right, normal_speed: 30.0 }), None]);
+    }
+
+    #[test]
+    fn restitution_scales_the_normal_velocity_only() {
+        let c = contain_in_arena(DVec2::new(0.0, -45.0), DVec2::new(3.0, -20.0), 10.0, HALF, 0.5);
+        assert_eq!(c.velocity, DVec2::new(3.0, 10.0));
+        assert_eq!(c.position, DVec2::new(0.0, -37.5));
+        assert_eq!(c.hits[1].unwrap().wall, Wall::Bottom);
+    }
+
+    #[test]
+    fn a_corner_gives_two_hits() {
+        let c = contain_in_arena(DVec2::new(-99.0, 49.0), DVec2::new(-1.0, 1.0), 2.0, HALF, 1.0);
+        assert_eq!(c.hits[0].unwrap().wall, Wall::Left);
+        assert_eq!(c.hits[1].unwrap().wall, Wall::Top);
+        assert_eq!(c.velocity, DVec2::new(1.0, -1.0));
+    }
+
+    #[test]
+    fn ball_moving_away_is_only_put_back() {
+        let c = contain_in_arena(DVec2::new(93.0, 0.0), DVec2::new(-5.0, 0.0), 10.0, HALF, 1.0);
+        assert_eq!(c.position, DVec2::new(90.0, 0.0));
+        assert_eq!(c.velocity, DVec2::new(-5.0, 0.0));
+        assert_eq!(c.hits, [None, None]);
+    }
+
+    #[test]
+    fn huge_overshoot_still_ends_inside() {
+        let c = contain_in_arena(DVec2::new(5000.0, 0.0), DVec2::new(1e5, 0.0), 10.0, HALF, 1.0);
+        assert!(c.position.x.abs() <= 90.0);
+    }
+
+    #[test]
+    fn ball_wider_than_the_arena_is_centred_without_nan() {
+        let c = contain_in_arena(DVec2::new(3.0, 3.0), DVec2::new(5.0, 5.0), 60.0, HALF, 1.0);
+        assert_eq!(c.position.y, 0.0);
+        assert_eq!(c.velocity.y, 0.0);
+        assert!(c.position.is_finite() && c.velocity.is_finite());
+        let c = contain_in_arena(DVec2::new(3.0, 3.0), DVec2::new(5.0, 5.0), 1.0, DVec2::ZERO, 1.0);
+        assert_eq!((c.position, c.velocity), (DVec2::ZERO, DVec2::ZERO));
+    }
+}

@@ -1,0 +1,112 @@
+//! The `ballpit` binary end to end: reports, dumps and exit codes.
+
+use std::process::{Command, Output};
+
+fn ballpit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ballpit"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("the ballpit binary runs")
+}
+
+const REPORT_FIELDS: [&str; 16] = [
+    "steps",
+    "sim_time_s",
+    "ms_per_step_median",
+    "ms_per_step_mean",
+    "ball_collisions",
+    "wall_collisions",
+    "kinetic_energy_start",
+    "kinetic_energy_end",
+    "momentum_start",
+    "momentum_end",
+    "max_overlap_rel",
+    "escaped",
+    "pressure",
+    "temperature",
+    "balls",
+    "dt_s",
+];
+
+#[test]
+fn run_prints_a_json_report_with_every_field() {
+    let out = ballpit(&["run", "--scene", "assets/scenes/gas.ron", "--steps", "30", "--balls", "200", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for field in REPORT_FIELDS {
+        assert!(report.get(field).is_some(), "missing {field}");
+    }
+    assert_eq!(report["steps"], 30);
+    assert_eq!(report["balls"], 200);
+    assert_eq!(report["escaped"], 0);
+    assert!((report["sim_time_s"].as_f64().unwrap() - 0.5).abs() < 1e-6);
+    assert!(report["ball_collisions"].as_u64().unwrap() > 0);
+    assert!(report["pressure"].as_f64().unwrap() > 0.0);
+    assert_eq!(report["momentum_end"].as_array().unwrap().len(), 2);
+    let energy_change = report["kinetic_energy_end"].as_f64().unwrap() / report["kinetic_energy_start"].as_f64().unwrap() - 1.0;
+    assert!(energy_change.abs() < 1e-9, "{energy_change}");
+}
+
+#[test]
+fn run_prints_a_readable_report_by_default() {
+    let out = ballpit(&["run", "--scene", "assets/scenes/head_on.ron", "--steps", "10"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for field in REPORT_FIELDS {
+        assert!(text.lines().any(|line| line.starts_with(field)), "missing {field} in\n{text}");
+    }
+}
+
+#[test]
+fn dump_writes_every_ball() {
+    let dir = std::env::temp_dir().join(format!("ballpit-dump-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("state.json");
+    let out = ballpit(&[
+        "run", "--scene", "assets/scenes/newtons_cradle.ron", "--steps", "5", "--json", "--dump",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let dump: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let balls = dump["balls"].as_array().unwrap();
+    assert_eq!(balls.len(), 6);
+    for (index, ball) in balls.iter().enumerate() {
+        assert_eq!(ball["id"], index);
+        for key in ["x", "y", "vx", "vy", "r", "m"] {
+            assert!(ball[key].is_number(), "{key} in {ball}");
+        }
+        assert_eq!(ball["r"], 20.0);
+        assert_eq!(ball["m"], 20.0);
+    }
+    assert!((balls[0]["x"].as_f64().unwrap() + 275.0).abs() < 1e-6);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    for args in [
+        &["run", "--scene", "assets/scenes/gas.ron"][..],
+        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "-3"],
+        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "3", "--dt", "0"],
+        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "3", "--dt", "NaN"],
+        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "3", "--bogus"],
+    ] {
+        let out = ballpit(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(!out.stderr.is_empty());
+    }
+}
+
+#[test]
+fn runtime_errors_exit_1_with_the_file_named() {
+    let out = ballpit(&["run", "--scene", "no/such.ron", "--steps", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such.ron"));
+    let out = ballpit(&["run", "--scene", "assets/scenes/head_on.ron", "--steps", "1", "--balls", "10"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("lacks"));
+    let out = ballpit(&["run", "--scene", "assets/scenes/gas.ron", "--steps", "1", "--balls", "100000000"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("limit"));
+}

@@ -1,0 +1,71 @@
+//! Shared builders: headless apps with given balls, and readers of their state.
+
+use ballpit::prelude::*;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+/// The fixed step every test uses, seconds.
+pub const DT: f64 = 1.0 / 60.0;
+
+/// A headless app with `params` and these balls (ids in the given order); no step run yet.
+pub fn app_with(params: SimParams, balls: &[BallState]) -> App {
+    let mut app = headless_app(DT);
+    let setup = SceneSetup {
+        params: params.clone(),
+        balls: balls.to_vec(),
+        rng: ballpit::sim::SimRng::default().0,
+    };
+    setup.apply(app.world_mut());
+    // `apply` keeps the pause state and broad phase already chosen; tests want all of `params`.
+    app.insert_resource(params);
+    app
+}
+
+pub fn ball(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> BallState {
+    BallState { position: DVec2::new(x, y), velocity: DVec2::new(vx, vy), radius }
+}
+
+/// Every ball's state, in id order.
+pub fn states(app: &mut App) -> Vec<BallState> {
+    let world = app.world_mut();
+    let mut balls: Vec<(BallId, BallState)> = world
+        .query::<(&BallId, &Position, &Velocity, &Radius)>()
+        .iter(world)
+        .map(|(id, p, v, r)| (*id, BallState { position: p.0, velocity: v.0, radius: r.0 }))
+        .collect();
+    balls.sort_by_key(|(id, _)| *id);
+    balls.into_iter().map(|(_, state)| state).collect()
+}
+
+/// Runs `steps` fixed steps.
+pub fn step(app: &mut App, steps: usize) {
+    for _ in 0..steps {
+        app.update();
+    }
+}
+
+/// Loads a shipped scene by file name, optionally with another count and seed.
+pub fn shipped_scene(name: &str) -> SceneFile {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes").join(name);
+    SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Collects every collision message into resources, for tests that audit each hit.
+#[derive(Resource, Default)]
+pub struct Recorded {
+    pub ball_hits: Vec<BallCollision>,
+    pub wall_hits: Vec<WallCollision>,
+}
+
+pub fn record_collisions(app: &mut App) {
+    fn record(
+        mut recorded: ResMut<Recorded>,
+        mut balls: MessageReader<BallCollision>,
+        mut walls: MessageReader<WallCollision>,
+    ) {
+        recorded.ball_hits.extend(balls.read().copied());
+        recorded.wall_hits.extend(walls.read().copied());
+    }
+    app.init_resource::<Recorded>()
+        .add_systems(FixedUpdate, record.after(SimSystems::Response));
+}

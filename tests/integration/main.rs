@@ -1,0 +1,7 @@
+//! The integration tests: one crate, so one link. Headless apps under `MinimalPlugins`, each
+//! `update()` exactly one fixed step (see `common`).
+
+mod cli;
+mod common;
+mod physics;
+mod scenes;
