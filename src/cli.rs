@@ -106,7 +106,10 @@ impl Cli {
 fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
     let (scene, origin) = match &args.scene {
         Some(path) => (SceneFile::load(path)?, path.display().to_string()),
-        None => (SceneFile::parse(DEMO_SCENE, "demo.ron")?, "demo.ron".to_string()),
+        None => (
+            SceneFile::parse(DEMO_SCENE, "demo.ron")?,
+            "demo.ron".to_string(),
+        ),
     };
     let setup = scene.build(&origin)?;
     let screenshot = args.screenshot.map(|path| (path, args.frames));
@@ -121,7 +124,10 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     let mut scene = SceneFile::load(&args.scene)?;
     if args.balls.is_some() || args.seed.is_some() {
         let Some(generate) = scene.generate.as_mut() else {
-            return Err(format!("{origin}: --balls and --seed override `generate`, which this scene lacks").into());
+            return Err(format!(
+                "{origin}: --balls and --seed override `generate`, which this scene lacks"
+            )
+            .into());
         };
         generate.count = args.balls.unwrap_or(generate.count);
         generate.seed = args.seed.unwrap_or(generate.seed);
@@ -136,7 +142,8 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     if let Some(path) = args.dump {
         let dump = StateDump::capture(app.world_mut());
         let text = serde_json::to_string(&dump)?;
-        std::fs::write(&path, text).map_err(|e| format!("{}: cannot write the dump: {e}", path.display()))?;
+        std::fs::write(&path, text)
+            .map_err(|e| format!("{}: cannot write the dump: {e}", path.display()))?;
     }
     Ok(())
 }

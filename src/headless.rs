@@ -8,7 +8,10 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
 
-use crate::sim::{Ball, BallId, Position, Radius, SceneSetup, SimParams, SimPlugin, SimStats, StateSummary, Velocity};
+use crate::sim::{
+    Ball, BallId, Position, Radius, SceneSetup, SimParams, SimPlugin, SimStats, StateSummary,
+    Velocity,
+};
 
 /// Default fixed step, seconds.
 pub const DEFAULT_DT: f64 = 1.0 / 60.0;
@@ -131,7 +134,11 @@ fn mean(values: &[f64]) -> f64 {
 }
 
 fn relative_change(start: f64, end: f64) -> f64 {
-    if start == 0.0 { 0.0 } else { (end - start) / start }
+    if start == 0.0 {
+        0.0
+    } else {
+        (end - start) / start
+    }
 }
 
 /// One ball in a `--dump` file.

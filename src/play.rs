@@ -36,8 +36,12 @@ pub fn play(options: PlayOptions) -> AppExit {
     .insert_resource(SceneToLoad(options.setup))
     .add_systems(Startup, load_scene);
     if let Some((path, frames)) = options.screenshot {
-        app.insert_resource(ScreenshotPlan { path, frames, requested_at: None })
-            .add_systems(Update, take_screenshot_and_exit);
+        app.insert_resource(ScreenshotPlan {
+            path,
+            frames,
+            requested_at: None,
+        })
+        .add_systems(Update, take_screenshot_and_exit);
     }
     app.run()
 }

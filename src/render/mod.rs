@@ -24,7 +24,10 @@ pub fn plugin(app: &mut App) {
         .add_systems(Startup, (spawn_camera, make_circle_texture))
         .add_observer(give_ball_a_sprite)
         .add_systems(Update, fit_arena_to_window)
-        .add_systems(PostUpdate, place_ball_sprites.before(TransformSystems::Propagate));
+        .add_systems(
+            PostUpdate,
+            place_ball_sprites.before(TransformSystems::Propagate),
+        );
 }
 
 /// The texture every ball sprite draws: a white disc with a one-texel soft edge.
@@ -47,7 +50,11 @@ fn make_circle_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>
         }
     }
     let mut image = Image::new(
-        Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+        Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
         TextureDimension::D2,
         data,
         TextureFormat::Rgba8UnormSrgb,
@@ -91,7 +98,10 @@ fn place_ball_sprites(mut balls: Query<(&Position, &mut Transform), With<Ball>>)
 
 /// The arena is the window's play area: its walls follow a resize (balls left outside are
 /// brought back in by the movement stage's wall containment).
-fn fit_arena_to_window(window: Single<&Window, With<PrimaryWindow>>, mut params: ResMut<SimParams>) {
+fn fit_arena_to_window(
+    window: Single<&Window, With<PrimaryWindow>>,
+    mut params: ResMut<SimParams>,
+) {
     let size = DVec2::new(window.width() as f64, window.height() as f64);
     if params.arena_size != size {
         params.arena_size = size;

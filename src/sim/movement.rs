@@ -40,7 +40,13 @@ pub struct Contained {
 
 /// Semi-implicit Euler with gravity and exponential damping over `dt` seconds.
 #[inline]
-pub fn integrate(position: DVec2, velocity: DVec2, gravity: DVec2, damping: f64, dt: f64) -> (DVec2, DVec2) {
+pub fn integrate(
+    position: DVec2,
+    velocity: DVec2,
+    gravity: DVec2,
+    damping: f64,
+    dt: f64,
+) -> (DVec2, DVec2) {
     let velocity = (velocity + gravity * dt) * (-damping * dt).exp();
     (position + velocity * dt, velocity)
 }
@@ -78,12 +84,19 @@ pub fn contain_in_arena(
             if speed_into_wall > 0.0 {
                 position[axis] = side * (limit - restitution * overshoot);
                 velocity[axis] = -side * restitution * speed_into_wall;
-                hits[axis] = Some(WallHit { wall, normal_speed: speed_into_wall });
+                hits[axis] = Some(WallHit {
+                    wall,
+                    normal_speed: speed_into_wall,
+                });
             }
             position[axis] = position[axis].clamp(-limit, limit);
         }
     }
-    Contained { position, velocity, hits }
+    Contained {
+        position,
+        velocity,
+        hits,
+    }
 }
 
 /// Where a ball of `radius` at `position` touches `wall` of the arena `[-half, half]`.
@@ -103,9 +116,11 @@ fn integrate_motion(
 ) {
     let dt = step_seconds(&time, &params);
     let (gravity, damping) = (params.gravity, params.linear_damping);
-    balls.par_iter_mut().for_each(|(mut position, mut velocity)| {
-        (position.0, velocity.0) = integrate(position.0, velocity.0, gravity, damping, dt);
-    });
+    balls
+        .par_iter_mut()
+        .for_each(|(mut position, mut velocity)| {
+            (position.0, velocity.0) = integrate(position.0, velocity.0, gravity, damping, dt);
+        });
 }
 
 /// Keeps every ball inside the arena, writing a [`WallCollision`] per bounce.
@@ -116,7 +131,8 @@ pub(super) fn bounce_off_walls(
 ) {
     let half = params.half_extents();
     for (ball, mut position, mut velocity, radius) in &mut balls {
-        let contained = contain_in_arena(position.0, velocity.0, radius.0, half, params.restitution);
+        let contained =
+            contain_in_arena(position.0, velocity.0, radius.0, half, params.restitution);
         if contained.position == position.0 && contained.velocity == velocity.0 {
             continue;
         }
@@ -126,7 +142,9 @@ pub(super) fn bounce_off_walls(
                 ball,
                 wall: hit.wall,
                 point: wall_contact_point(hit.wall, position.0, half),
-                impulse: params.mass_model.mass(radius.0) * (1.0 + params.restitution) * hit.normal_speed,
+                impulse: params.mass_model.mass(radius.0)
+                    * (1.0 + params.restitution)
+                    * hit.normal_speed,
                 normal_speed: hit.normal_speed,
             });
         }
@@ -141,7 +159,13 @@ mod tests {
 
     #[test]
     fn integration_applies_gravity_before_moving() {
-        let (p, v) = integrate(DVec2::ZERO, DVec2::new(10.0, 0.0), DVec2::new(0.0, -10.0), 0.0, 0.5);
+        let (p, v) = integrate(
+            DVec2::ZERO,
+            DVec2::new(10.0, 0.0),
+            DVec2::new(0.0, -10.0),
+            0.0,
+            0.5,
+        );
         assert_eq!(v, DVec2::new(10.0, -5.0));
         assert_eq!(p, DVec2::new(5.0, -2.5));
     }
@@ -154,15 +178,36 @@ mod tests {
 
     #[test]
     fn ball_past_the_right_wall_is_mirrored_back_and_reflected() {
-        let c = contain_in_arena(DVec2::new(95.0, 0.0), DVec2::new(30.0, 7.0), 10.0, HALF, 1.0);
+        let c = contain_in_arena(
+            DVec2::new(95.0, 0.0),
+            DVec2::new(30.0, 7.0),
+            10.0,
+            HALF,
+            1.0,
+        );
         assert_eq!(c.position, DVec2::new(85.0, 0.0));
         assert_eq!(c.velocity, DVec2::new(-30.0, 7.0));
-        assert_eq!(c.hits, [Some(WallHit { wall: Wall::Right, normal_speed: 30.0 }), None]);
+        assert_eq!(
+            c.hits,
+            [
+                Some(WallHit {
+                    wall: Wall::Right,
+                    normal_speed: 30.0
+                }),
+                None
+            ]
+        );
     }
 
     #[test]
     fn restitution_scales_the_normal_velocity_only() {
-        let c = contain_in_arena(DVec2::new(0.0, -45.0), DVec2::new(3.0, -20.0), 10.0, HALF, 0.5);
+        let c = contain_in_arena(
+            DVec2::new(0.0, -45.0),
+            DVec2::new(3.0, -20.0),
+            10.0,
+            HALF,
+            0.5,
+        );
         assert_eq!(c.velocity, DVec2::new(3.0, 10.0));
         assert_eq!(c.position, DVec2::new(0.0, -37.5));
         assert_eq!(c.hits[1].unwrap().wall, Wall::Bottom);
@@ -170,7 +215,13 @@ mod tests {
 
     #[test]
     fn a_corner_gives_two_hits() {
-        let c = contain_in_arena(DVec2::new(-99.0, 49.0), DVec2::new(-1.0, 1.0), 2.0, HALF, 1.0);
+        let c = contain_in_arena(
+            DVec2::new(-99.0, 49.0),
+            DVec2::new(-1.0, 1.0),
+            2.0,
+            HALF,
+            1.0,
+        );
         assert_eq!(c.hits[0].unwrap().wall, Wall::Left);
         assert_eq!(c.hits[1].unwrap().wall, Wall::Top);
         assert_eq!(c.velocity, DVec2::new(1.0, -1.0));
@@ -178,7 +229,13 @@ mod tests {
 
     #[test]
     fn ball_moving_away_is_only_put_back() {
-        let c = contain_in_arena(DVec2::new(93.0, 0.0), DVec2::new(-5.0, 0.0), 10.0, HALF, 1.0);
+        let c = contain_in_arena(
+            DVec2::new(93.0, 0.0),
+            DVec2::new(-5.0, 0.0),
+            10.0,
+            HALF,
+            1.0,
+        );
         assert_eq!(c.position, DVec2::new(90.0, 0.0));
         assert_eq!(c.velocity, DVec2::new(-5.0, 0.0));
         assert_eq!(c.hits, [None, None]);
@@ -186,7 +243,13 @@ mod tests {
 
     #[test]
     fn huge_overshoot_still_ends_inside() {
-        let c = contain_in_arena(DVec2::new(5000.0, 0.0), DVec2::new(1e5, 0.0), 10.0, HALF, 1.0);
+        let c = contain_in_arena(
+            DVec2::new(5000.0, 0.0),
+            DVec2::new(1e5, 0.0),
+            10.0,
+            HALF,
+            1.0,
+        );
         assert!(c.position.x.abs() <= 90.0);
     }
 
@@ -196,7 +259,13 @@ mod tests {
         assert_eq!(c.position.y, 0.0);
         assert_eq!(c.velocity.y, 0.0);
         assert!(c.position.is_finite() && c.velocity.is_finite());
-        let c = contain_in_arena(DVec2::new(3.0, 3.0), DVec2::new(5.0, 5.0), 1.0, DVec2::ZERO, 1.0);
+        let c = contain_in_arena(
+            DVec2::new(3.0, 3.0),
+            DVec2::new(5.0, 5.0),
+            1.0,
+            DVec2::ZERO,
+            1.0,
+        );
         assert_eq!((c.position, c.velocity), (DVec2::ZERO, DVec2::ZERO));
     }
 }

@@ -124,7 +124,8 @@ impl SimParams {
             }
         };
         for axis in 0..2 {
-            self.arena_size[axis] = clamp(self.arena_size[axis], 0.0..=*ARENA_SIDE_RANGE.end(), 0.0);
+            self.arena_size[axis] =
+                clamp(self.arena_size[axis], 0.0..=*ARENA_SIDE_RANGE.end(), 0.0);
             self.gravity[axis] = clamp(self.gravity[axis], -MAX_GRAVITY..=MAX_GRAVITY, 0.0);
         }
         self.restitution = clamp(self.restitution, RESTITUTION_RANGE, defaults.restitution);

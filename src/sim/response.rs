@@ -90,8 +90,12 @@ fn resolve_contacts(
     mut collisions: MessageWriter<BallCollision>,
 ) {
     for contact in &contacts.0 {
-        let Ok([(mut position_a, mut velocity_a, radius_a), (mut position_b, mut velocity_b, radius_b)]) =
-            balls.get_many_mut([contact.a, contact.b])
+        let Ok(
+            [
+                (mut position_a, mut velocity_a, radius_a),
+                (mut position_b, mut velocity_b, radius_b),
+            ],
+        ) = balls.get_many_mut([contact.a, contact.b])
         else {
             continue;
         };
@@ -139,8 +143,15 @@ mod tests {
 
     #[test]
     fn tutorial_worked_example_equal_masses_swap_velocities() {
-        let ex = normal_exchange(DVec2::new(5.0, 0.0), DVec2::new(-1.0, 0.0), 0.1, 0.1, DVec2::X, 1.0)
-            .unwrap();
+        let ex = normal_exchange(
+            DVec2::new(5.0, 0.0),
+            DVec2::new(-1.0, 0.0),
+            0.1,
+            0.1,
+            DVec2::X,
+            1.0,
+        )
+        .unwrap();
         assert_eq!(ex.velocity_a, DVec2::new(-1.0, 0.0));
         assert_eq!(ex.velocity_b, DVec2::new(5.0, 0.0));
         assert_eq!(ex.closing_speed, 6.0);
@@ -151,8 +162,15 @@ mod tests {
     fn unequal_masses_head_on_match_the_textbook_formulas() {
         let (m1, m2, u1, u2) = (3.0, 7.0, 4.0, -2.0);
         for e in [0.0, 0.25, 1.0] {
-            let ex = normal_exchange(DVec2::new(u1, 0.0), DVec2::new(u2, 0.0), 1.0 / m1, 1.0 / m2, DVec2::X, e)
-                .unwrap();
+            let ex = normal_exchange(
+                DVec2::new(u1, 0.0),
+                DVec2::new(u2, 0.0),
+                1.0 / m1,
+                1.0 / m2,
+                DVec2::X,
+                e,
+            )
+            .unwrap();
             let v1 = (m1 * u1 + m2 * u2 - m2 * e * (u1 - u2)) / (m1 + m2);
             let v2 = (m1 * u1 + m2 * u2 + m1 * e * (u1 - u2)) / (m1 + m2);
             assert!((ex.velocity_a.x - v1).abs() < 1e-12, "e = {e}");
@@ -173,7 +191,12 @@ mod tests {
     #[test]
     fn momentum_is_kept_and_energy_scales_with_restitution() {
         let normal = DVec2::new(1.0, 1.0).normalize();
-        let (va, vb, ia, ib) = (DVec2::new(7.0, -1.0), DVec2::new(-3.0, 2.0), 1.0 / 4.0, 1.0 / 9.0);
+        let (va, vb, ia, ib) = (
+            DVec2::new(7.0, -1.0),
+            DVec2::new(-3.0, 2.0),
+            1.0 / 4.0,
+            1.0 / 9.0,
+        );
         let reduced_mass = 1.0 / (ia + ib);
         let closing = (va - vb).dot(normal);
         let energy_before = kinetic_energy(va, ia) + kinetic_energy(vb, ib);
@@ -182,16 +205,40 @@ mod tests {
             let momentum_before = va / ia + vb / ib;
             let momentum_after = ex.velocity_a / ia + ex.velocity_b / ib;
             assert!((momentum_after - momentum_before).length() < 1e-12);
-            let energy_after = kinetic_energy(ex.velocity_a, ia) + kinetic_energy(ex.velocity_b, ib);
+            let energy_after =
+                kinetic_energy(ex.velocity_a, ia) + kinetic_energy(ex.velocity_b, ib);
             let expected_loss = 0.5 * (1.0 - e * e) * reduced_mass * closing * closing;
-            assert!((energy_before - energy_after - expected_loss).abs() < 1e-10, "e = {e}");
+            assert!(
+                (energy_before - energy_after - expected_loss).abs() < 1e-10,
+                "e = {e}"
+            );
         }
     }
 
     #[test]
     fn separating_pairs_are_left_alone() {
-        assert_eq!(normal_exchange(DVec2::new(-1.0, 0.0), DVec2::new(1.0, 0.0), 1.0, 1.0, DVec2::X, 1.0), None);
-        assert_eq!(normal_exchange(DVec2::new(0.0, 3.0), DVec2::new(0.0, 3.0), 1.0, 1.0, DVec2::X, 1.0), None);
+        assert_eq!(
+            normal_exchange(
+                DVec2::new(-1.0, 0.0),
+                DVec2::new(1.0, 0.0),
+                1.0,
+                1.0,
+                DVec2::X,
+                1.0
+            ),
+            None
+        );
+        assert_eq!(
+            normal_exchange(
+                DVec2::new(0.0, 3.0),
+                DVec2::new(0.0, 3.0),
+                1.0,
+                1.0,
+                DVec2::X,
+                1.0
+            ),
+            None
+        );
     }
 
     #[test]

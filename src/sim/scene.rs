@@ -158,12 +158,17 @@ impl SceneFile {
     /// Reads and parses the scene file at `path`.
     pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
         let origin = path.display().to_string();
-        let read_error = |source| SceneError::Read { origin: origin.clone(), source };
+        let read_error = |source| SceneError::Read {
+            origin: origin.clone(),
+            source,
+        };
         let size = std::fs::metadata(path).map_err(read_error)?.len();
         if size > MAX_SCENE_BYTES {
             return Err(SceneError::Invalid {
                 origin,
-                message: format!("the file is {size} bytes; scene files are limited to {MAX_SCENE_BYTES}"),
+                message: format!(
+                    "the file is {size} bytes; scene files are limited to {MAX_SCENE_BYTES}"
+                ),
             });
         }
         let text = std::fs::read_to_string(path).map_err(read_error)?;
@@ -191,24 +196,38 @@ impl SceneFile {
 
     /// Validates the scene and draws its random balls; `origin` names it in errors.
     pub fn build(&self, origin: &str) -> Result<SceneSetup, SceneError> {
-        let invalid = |message: String| SceneError::Invalid { origin: origin.to_string(), message };
+        let invalid = |message: String| SceneError::Invalid {
+            origin: origin.to_string(),
+            message,
+        };
         let params = self.physics().map_err(invalid)?;
         let hand_placed = self.hand_placed_balls().map_err(invalid)?;
         let seed = self.generate.map_or(0, |g| g.seed);
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let drawn = match &self.generate {
-            Some(generate) => generate.draw(hand_placed.len(), &mut rng).map_err(invalid)?,
+            Some(generate) => generate
+                .draw(hand_placed.len(), &mut rng)
+                .map_err(invalid)?,
             None => Vec::new(),
         };
         let arena_size = self.arena_size(&hand_placed, &drawn).map_err(invalid)?;
         let balls = place_balls(hand_placed, drawn, arena_size, &mut rng).map_err(invalid)?;
-        Ok(SceneSetup { params: SimParams { arena_size, ..params }, balls, rng })
+        Ok(SceneSetup {
+            params: SimParams {
+                arena_size,
+                ..params
+            },
+            balls,
+            rng,
+        })
     }
 
     fn physics(&self) -> Result<SimParams, String> {
         let gravity = DVec2::from(self.gravity);
         if !(gravity.is_finite() && gravity.abs().max_element() <= MAX_GRAVITY) {
-            return Err(format!("gravity {gravity} must be finite, each component within ±{MAX_GRAVITY}"));
+            return Err(format!(
+                "gravity {gravity} must be finite, each component within ±{MAX_GRAVITY}"
+            ));
         }
         check_range("restitution", self.restitution, &RESTITUTION_RANGE)?;
         check_range("linear_damping", self.linear_damping, &DAMPING_RANGE)?;
@@ -223,7 +242,10 @@ impl SceneFile {
 
     fn hand_placed_balls(&self) -> Result<Vec<BallState>, String> {
         if self.balls.len() > MAX_BALLS {
-            return Err(format!("{} balls listed; the limit is {MAX_BALLS}", self.balls.len()));
+            return Err(format!(
+                "{} balls listed; the limit is {MAX_BALLS}",
+                self.balls.len()
+            ));
         }
         self.balls
             .iter()
@@ -236,7 +258,10 @@ impl SceneFile {
                 };
                 check_range(&format!("ball {index}: radius"), ball.radius, &RADIUS_RANGE)?;
                 if !ball.position.is_finite() {
-                    return Err(format!("ball {index}: position {} is not finite", ball.position));
+                    return Err(format!(
+                        "ball {index}: position {} is not finite",
+                        ball.position
+                    ));
                 }
                 if !(ball.velocity.is_finite() && ball.velocity.length() <= MAX_SPEED) {
                     return Err(format!(
@@ -257,7 +282,10 @@ impl SceneFile {
             }
             (Some(arena), None) => DVec2::new(arena.width, arena.height),
             (None, Some(fraction)) => {
-                let ball_area: f64 = hand_placed.iter().map(|b| b.radius).chain(drawn.iter().map(|b| b.radius))
+                let ball_area: f64 = hand_placed
+                    .iter()
+                    .map(|b| b.radius)
+                    .chain(drawn.iter().map(|b| b.radius))
                     .map(|r| std::f64::consts::PI * r * r)
                     .sum();
                 DVec2::splat((ball_area / fraction).sqrt())
@@ -287,14 +315,21 @@ impl Generate {
         check_range("generate.speed min", s_min, &(0.0..=MAX_SPEED))?;
         check_range("generate.speed max", s_max, &(s_min..=MAX_SPEED))?;
         if let Some(fraction) = self.area_fraction {
-            check_range("generate.area_fraction", fraction, &(f64::MIN_POSITIVE..=DENSEST_PACKING))?;
+            check_range(
+                "generate.area_fraction",
+                fraction,
+                &(f64::MIN_POSITIVE..=DENSEST_PACKING),
+            )?;
         }
         Ok((0..self.count)
             .map(|_| {
                 let radius = rng.random_range(r_min..=r_max);
                 let speed = rng.random_range(s_min..=s_max);
                 let direction = rng.random_range(0.0..std::f64::consts::TAU);
-                DrawnBall { radius, velocity: DVec2::from_angle(direction) * speed }
+                DrawnBall {
+                    radius,
+                    velocity: DVec2::from_angle(direction) * speed,
+                }
             })
             .collect())
     }
@@ -306,11 +341,19 @@ struct DrawnBall {
     velocity: DVec2,
 }
 
-fn check_range(name: &str, value: f64, range: &std::ops::RangeInclusive<f64>) -> Result<(), String> {
+fn check_range(
+    name: &str,
+    value: f64,
+    range: &std::ops::RangeInclusive<f64>,
+) -> Result<(), String> {
     if range.contains(&value) {
         Ok(())
     } else {
-        Err(format!("{name} is {value}; it must lie in [{}, {}]", range.start(), range.end()))
+        Err(format!(
+            "{name} is {value}; it must lie in [{}, {}]",
+            range.start(),
+            range.end()
+        ))
     }
 }
 
@@ -323,7 +366,10 @@ fn place_balls(
     rng: &mut ChaCha8Rng,
 ) -> Result<Vec<BallState>, String> {
     let half = arena_size * 0.5;
-    let ball_area: f64 = hand_placed.iter().map(|b| b.radius).chain(drawn.iter().map(|b| b.radius))
+    let ball_area: f64 = hand_placed
+        .iter()
+        .map(|b| b.radius)
+        .chain(drawn.iter().map(|b| b.radius))
         .map(|r| std::f64::consts::PI * r * r)
         .sum();
     let covered = ball_area / (arena_size.x * arena_size.y);
@@ -336,7 +382,10 @@ fn place_balls(
             DENSEST_PACKING * 100.0
         ));
     }
-    let largest_radius = hand_placed.iter().map(|b| b.radius).chain(drawn.iter().map(|b| b.radius))
+    let largest_radius = hand_placed
+        .iter()
+        .map(|b| b.radius)
+        .chain(drawn.iter().map(|b| b.radius))
         .fold(0.0, f64::max);
     let total = hand_placed.len() + drawn.len();
     let mut grid = PlacementGrid::new(half, largest_radius, total);
@@ -382,7 +431,11 @@ fn place_balls(
             ));
         };
         grid.insert(circle);
-        balls.push(BallState { position: circle.center, velocity: ball.velocity, radius: ball.radius });
+        balls.push(BallState {
+            position: circle.center,
+            velocity: ball.velocity,
+            radius: ball.radius,
+        });
     }
     Ok(balls)
 }
@@ -472,7 +525,10 @@ impl SceneSetup {
         for entity in old_balls {
             world.despawn(entity);
         }
-        let mut params = world.get_resource::<SimParams>().cloned().unwrap_or_default();
+        let mut params = world
+            .get_resource::<SimParams>()
+            .cloned()
+            .unwrap_or_default();
         params.arena_size = self.params.arena_size;
         params.gravity = self.params.gravity;
         params.restitution = self.params.restitution;
@@ -500,10 +556,19 @@ mod tests {
     fn placement_grid_finds_overlaps_across_cells() {
         let mut grid = PlacementGrid::new(DVec2::splat(100.0), 5.0, 10);
         grid.insert(Circle::new(DVec2::new(9.0, 9.0), 5.0));
-        assert_eq!(grid.first_overlap(Circle::new(DVec2::new(17.0, 9.0), 5.0)), Some(0));
-        assert_eq!(grid.first_overlap(Circle::new(DVec2::new(19.0, 9.0), 5.0)), None);
+        assert_eq!(
+            grid.first_overlap(Circle::new(DVec2::new(17.0, 9.0), 5.0)),
+            Some(0)
+        );
+        assert_eq!(
+            grid.first_overlap(Circle::new(DVec2::new(19.0, 9.0), 5.0)),
+            None
+        );
         // Just touching is allowed.
-        assert_eq!(grid.first_overlap(Circle::new(DVec2::new(9.0, 19.0), 5.0)), None);
+        assert_eq!(
+            grid.first_overlap(Circle::new(DVec2::new(9.0, 19.0), 5.0)),
+            None
+        );
     }
 
     #[test]

@@ -128,8 +128,8 @@ impl StateSummary {
             let mass = params.mass_model.mass(radius.0);
             summary.ball_count += 1;
             summary.kinetic_energy += kinetic_energy(mass, velocity.0);
-            summary.mechanical_energy +=
-                kinetic_energy(mass, velocity.0) + potential_energy(mass, position.0, params.gravity);
+            summary.mechanical_energy += kinetic_energy(mass, velocity.0)
+                + potential_energy(mass, position.0, params.gravity);
             summary.momentum += velocity.0 * mass;
             if position.x.abs() > half.x || position.y.abs() > half.y {
                 summary.escaped += 1;
@@ -140,11 +140,18 @@ impl StateSummary {
             circles.push(Circle::new(position.0, radius.0));
         }
         let mut contacts: Vec<IndexedContact> = Vec::new();
-        find_contacts(&circles, BroadPhase::Grid, &mut UniformGrid::default(), &mut contacts);
+        find_contacts(
+            &circles,
+            BroadPhase::Grid,
+            &mut UniformGrid::default(),
+            &mut contacts,
+        );
         summary.max_overlap_rel = contacts
             .iter()
             .map(|c| {
-                let smaller = circles[c.a as usize].radius.min(circles[c.b as usize].radius);
+                let smaller = circles[c.a as usize]
+                    .radius
+                    .min(circles[c.b as usize].radius);
                 c.geometry.depth / smaller
             })
             .fold(0.0, f64::max);
@@ -159,12 +166,19 @@ mod tests {
     #[test]
     fn energy_formulas() {
         assert_eq!(kinetic_energy(2.0, DVec2::new(3.0, 4.0)), 25.0);
-        assert_eq!(potential_energy(2.0, DVec2::new(0.0, 10.0), DVec2::new(0.0, -9.0)), 180.0);
+        assert_eq!(
+            potential_energy(2.0, DVec2::new(0.0, 10.0), DVec2::new(0.0, -9.0)),
+            180.0
+        );
     }
 
     #[test]
     fn pressure_is_impulse_per_perimeter_and_time() {
-        let stats = SimStats { sim_time: 2.0, wall_impulse: 80.0, ..default() };
+        let stats = SimStats {
+            sim_time: 2.0,
+            wall_impulse: 80.0,
+            ..default()
+        };
         assert_eq!(stats.pressure(DVec2::new(6.0, 4.0)), 2.0);
         assert_eq!(SimStats::default().pressure(DVec2::new(6.0, 4.0)), 0.0);
     }

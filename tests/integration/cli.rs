@@ -31,8 +31,21 @@ const REPORT_FIELDS: [&str; 16] = [
 
 #[test]
 fn run_prints_a_json_report_with_every_field() {
-    let out = ballpit(&["run", "--scene", "assets/scenes/gas.ron", "--steps", "30", "--balls", "200", "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/gas.ron",
+        "--steps",
+        "30",
+        "--balls",
+        "200",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for field in REPORT_FIELDS {
         assert!(report.get(field).is_some(), "missing {field}");
@@ -44,17 +57,28 @@ fn run_prints_a_json_report_with_every_field() {
     assert!(report["ball_collisions"].as_u64().unwrap() > 0);
     assert!(report["pressure"].as_f64().unwrap() > 0.0);
     assert_eq!(report["momentum_end"].as_array().unwrap().len(), 2);
-    let energy_change = report["kinetic_energy_end"].as_f64().unwrap() / report["kinetic_energy_start"].as_f64().unwrap() - 1.0;
+    let energy_change = report["kinetic_energy_end"].as_f64().unwrap()
+        / report["kinetic_energy_start"].as_f64().unwrap()
+        - 1.0;
     assert!(energy_change.abs() < 1e-9, "{energy_change}");
 }
 
 #[test]
 fn run_prints_a_readable_report_by_default() {
-    let out = ballpit(&["run", "--scene", "assets/scenes/head_on.ron", "--steps", "10"]);
+    let out = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/head_on.ron",
+        "--steps",
+        "10",
+    ]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     for field in REPORT_FIELDS {
-        assert!(text.lines().any(|line| line.starts_with(field)), "missing {field} in\n{text}");
+        assert!(
+            text.lines().any(|line| line.starts_with(field)),
+            "missing {field} in\n{text}"
+        );
     }
 }
 
@@ -64,11 +88,22 @@ fn dump_writes_every_ball() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("state.json");
     let out = ballpit(&[
-        "run", "--scene", "assets/scenes/newtons_cradle.ron", "--steps", "5", "--json", "--dump",
+        "run",
+        "--scene",
+        "assets/scenes/newtons_cradle.ron",
+        "--steps",
+        "5",
+        "--json",
+        "--dump",
         path.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let dump: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dump: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let balls = dump["balls"].as_array().unwrap();
     assert_eq!(balls.len(), 6);
     for (index, ball) in balls.iter().enumerate() {
@@ -88,9 +123,32 @@ fn usage_errors_exit_2() {
     for args in [
         &["run", "--scene", "assets/scenes/gas.ron"][..],
         &["run", "--scene", "assets/scenes/gas.ron", "--steps", "-3"],
-        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "3", "--dt", "0"],
-        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "3", "--dt", "NaN"],
-        &["run", "--scene", "assets/scenes/gas.ron", "--steps", "3", "--bogus"],
+        &[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "3",
+            "--dt",
+            "0",
+        ],
+        &[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "3",
+            "--dt",
+            "NaN",
+        ],
+        &[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "3",
+            "--bogus",
+        ],
     ] {
         let out = ballpit(args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -103,10 +161,26 @@ fn runtime_errors_exit_1_with_the_file_named() {
     let out = ballpit(&["run", "--scene", "no/such.ron", "--steps", "1"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such.ron"));
-    let out = ballpit(&["run", "--scene", "assets/scenes/head_on.ron", "--steps", "1", "--balls", "10"]);
+    let out = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/head_on.ron",
+        "--steps",
+        "1",
+        "--balls",
+        "10",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("lacks"));
-    let out = ballpit(&["run", "--scene", "assets/scenes/gas.ron", "--steps", "1", "--balls", "100000000"]);
+    let out = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/gas.ron",
+        "--steps",
+        "1",
+        "--balls",
+        "100000000",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("limit"));
 }

@@ -22,7 +22,11 @@ pub fn app_with(params: SimParams, balls: &[BallState]) -> App {
 }
 
 pub fn ball(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> BallState {
-    BallState { position: DVec2::new(x, y), velocity: DVec2::new(vx, vy), radius }
+    BallState {
+        position: DVec2::new(x, y),
+        velocity: DVec2::new(vx, vy),
+        radius,
+    }
 }
 
 /// Every ball's state, in id order.
@@ -31,7 +35,16 @@ pub fn states(app: &mut App) -> Vec<BallState> {
     let mut balls: Vec<(BallId, BallState)> = world
         .query::<(&BallId, &Position, &Velocity, &Radius)>()
         .iter(world)
-        .map(|(id, p, v, r)| (*id, BallState { position: p.0, velocity: v.0, radius: r.0 }))
+        .map(|(id, p, v, r)| {
+            (
+                *id,
+                BallState {
+                    position: p.0,
+                    velocity: v.0,
+                    radius: r.0,
+                },
+            )
+        })
         .collect();
     balls.sort_by_key(|(id, _)| *id);
     balls.into_iter().map(|(_, state)| state).collect()
@@ -46,7 +59,9 @@ pub fn step(app: &mut App, steps: usize) {
 
 /// Loads a shipped scene by file name, optionally with another count and seed.
 pub fn shipped_scene(name: &str) -> SceneFile {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes").join(name);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/scenes")
+        .join(name);
     SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -12,7 +12,10 @@ use rand::{RngExt, SeedableRng};
 use crate::common::*;
 
 fn params() -> SimParams {
-    SimParams { arena_size: DVec2::new(2000.0, 2000.0), ..default() }
+    SimParams {
+        arena_size: DVec2::new(2000.0, 2000.0),
+        ..default()
+    }
 }
 
 #[test]
@@ -28,20 +31,42 @@ fn one_update_is_exactly_one_fixed_step() {
 #[test]
 fn tutorial_worked_example_masses_10_and_10_at_5_and_minus_1() {
     // Radius 10 with mass = radius: both masses 10. Touching now, overlapping after one move.
-    let mut app = app_with(params(), &[ball(-10.0, 0.0, 5.0, 0.0, 10.0), ball(10.0, 0.0, -1.0, 0.0, 10.0)]);
+    let mut app = app_with(
+        params(),
+        &[
+            ball(-10.0, 0.0, 5.0, 0.0, 10.0),
+            ball(10.0, 0.0, -1.0, 0.0, 10.0),
+        ],
+    );
     step(&mut app, 1);
     let balls = states(&mut app);
-    assert!((balls[0].velocity - DVec2::new(-1.0, 0.0)).length() < 1e-12, "{:?}", balls[0]);
-    assert!((balls[1].velocity - DVec2::new(5.0, 0.0)).length() < 1e-12, "{:?}", balls[1]);
+    assert!(
+        (balls[0].velocity - DVec2::new(-1.0, 0.0)).length() < 1e-12,
+        "{:?}",
+        balls[0]
+    );
+    assert!(
+        (balls[1].velocity - DVec2::new(5.0, 0.0)).length() < 1e-12,
+        "{:?}",
+        balls[1]
+    );
     assert_eq!(app.world().resource::<SimStats>().ball_collisions, 1);
 }
 
 #[test]
 fn unequal_masses_head_on_follow_the_1d_elastic_formulas() {
-    for (mass_model, e) in [(MassModel::Radius, 1.0), (MassModel::Area, 1.0), (MassModel::Radius, 0.4)] {
+    for (mass_model, e) in [
+        (MassModel::Radius, 1.0),
+        (MassModel::Area, 1.0),
+        (MassModel::Radius, 0.4),
+    ] {
         let (r1, r2, u1, u2) = (5.0, 20.0, 30.0, -12.0);
         let mut app = app_with(
-            SimParams { mass_model, restitution: e, ..params() },
+            SimParams {
+                mass_model,
+                restitution: e,
+                ..params()
+            },
             &[ball(-5.0, 0.0, u1, 0.0, r1), ball(20.0, 0.0, u2, 0.0, r2)],
         );
         step(&mut app, 1);
@@ -49,8 +74,16 @@ fn unequal_masses_head_on_follow_the_1d_elastic_formulas() {
         let v1 = (m1 * u1 + m2 * u2 - m2 * e * (u1 - u2)) / (m1 + m2);
         let v2 = (m1 * u1 + m2 * u2 + m1 * e * (u1 - u2)) / (m1 + m2);
         let balls = states(&mut app);
-        assert!((balls[0].velocity.x - v1).abs() < 1e-9, "{mass_model:?} e={e}: {} vs {v1}", balls[0].velocity.x);
-        assert!((balls[1].velocity.x - v2).abs() < 1e-9, "{mass_model:?} e={e}: {} vs {v2}", balls[1].velocity.x);
+        assert!(
+            (balls[0].velocity.x - v1).abs() < 1e-9,
+            "{mass_model:?} e={e}: {} vs {v1}",
+            balls[0].velocity.x
+        );
+        assert!(
+            (balls[1].velocity.x - v2).abs() < 1e-9,
+            "{mass_model:?} e={e}: {} vs {v2}",
+            balls[1].velocity.x
+        );
         assert_eq!(balls[0].velocity.y, 0.0);
     }
 }
@@ -59,7 +92,13 @@ fn unequal_masses_head_on_follow_the_1d_elastic_formulas() {
 fn off_centre_hit_on_a_still_ball_parts_at_right_angles() {
     // Equal masses; the mover's line passes 8 px off the still ball's centre (radii sum 20).
     let speed = 60.0;
-    let mut app = app_with(params(), &[ball(-40.0, 0.0, speed, 0.0, 10.0), ball(0.0, 8.0, 0.0, 0.0, 10.0)]);
+    let mut app = app_with(
+        params(),
+        &[
+            ball(-40.0, 0.0, speed, 0.0, 10.0),
+            ball(0.0, 8.0, 0.0, 0.0, 10.0),
+        ],
+    );
     record_collisions(&mut app);
     step(&mut app, 60);
     let hits = app.world().resource::<Recorded>().ball_hits.clone();
@@ -68,7 +107,10 @@ fn off_centre_hit_on_a_still_ball_parts_at_right_angles() {
     // Analytic impact normal for impact parameter 8 and reach 20: (sqrt(1 - 0.4^2), 0.4).
     // Discrete detection sees the pair up to one step (1 px) late, so the normal is close.
     let exact_normal = DVec2::new((1.0f64 - 0.16).sqrt(), 0.4);
-    assert!(normal.angle_to(exact_normal).abs() < 0.06, "normal {normal}");
+    assert!(
+        normal.angle_to(exact_normal).abs() < 0.06,
+        "normal {normal}"
+    );
     let balls = states(&mut app);
     let (mover, struck) = (balls[0].velocity, balls[1].velocity);
     // The struck ball leaves along the line of centres with the mover's normal component...
@@ -106,13 +148,23 @@ fn momentum_and_energy_are_kept_with_restitution_one() {
     for (i, b) in balls.iter_mut().enumerate() {
         b.velocity = -b.position.normalize_or_zero() * (100.0 + i as f64);
     }
-    let mut app = app_with(SimParams { arena_size: DVec2::splat(1.0e5), ..default() }, &balls);
+    let mut app = app_with(
+        SimParams {
+            arena_size: DVec2::splat(1.0e5),
+            ..default()
+        },
+        &balls,
+    );
     let (momentum_start, energy_start) = momentum_and_energy(&mut app);
     let momentum_scale: f64 = balls.iter().map(|b| b.radius * b.velocity.length()).sum();
     step(&mut app, 120);
     let (momentum_end, energy_end) = momentum_and_energy(&mut app);
     let stats = app.world().resource::<SimStats>().clone();
-    assert!(stats.ball_collisions > 100, "only {} collisions", stats.ball_collisions);
+    assert!(
+        stats.ball_collisions > 100,
+        "only {} collisions",
+        stats.ball_collisions
+    );
     assert_eq!(stats.wall_collisions, 0);
     assert!((momentum_end - momentum_start).length() < 1e-12 * momentum_scale);
     assert!(((energy_end - energy_start) / energy_start).abs() < 1e-12);
@@ -124,14 +176,22 @@ fn every_hit_loses_exactly_the_restitution_share_of_energy() {
     // mass is infinite, so mu = m there).
     let e = 0.7;
     let mut app = app_with(
-        SimParams { arena_size: DVec2::splat(420.0), restitution: e, ..default() },
+        SimParams {
+            arena_size: DVec2::splat(420.0),
+            restitution: e,
+            ..default()
+        },
         &cluster(120, 4, 400.0),
     );
     record_collisions(&mut app);
     let (_, energy_start) = momentum_and_energy(&mut app);
     let masses: std::collections::HashMap<Entity, f64> = {
         let world = app.world_mut();
-        world.query::<(Entity, &Radius)>().iter(world).map(|(e, r)| (e, r.0)).collect()
+        world
+            .query::<(Entity, &Radius)>()
+            .iter(world)
+            .map(|(e, r)| (e, r.0))
+            .collect()
     };
     step(&mut app, 90);
     let (_, energy_end) = momentum_and_energy(&mut app);
@@ -154,7 +214,10 @@ fn every_hit_loses_exactly_the_restitution_share_of_energy() {
     let expected = ball_loss + wall_loss;
     let actual = energy_start - energy_end;
     assert!(actual > 0.0);
-    assert!((actual - expected).abs() < 1e-9 * energy_start, "lost {actual}, expected {expected}");
+    assert!(
+        (actual - expected).abs() < 1e-9 * energy_start,
+        "lost {actual}, expected {expected}"
+    );
 }
 
 #[test]
@@ -162,13 +225,21 @@ fn collision_messages_report_the_impulse_that_was_applied() {
     // impulse = (1 + e) * mu * v_n along a unit normal, for every message.
     let e = 0.8;
     let mut app = app_with(
-        SimParams { arena_size: DVec2::splat(1.0e5), restitution: e, ..default() },
+        SimParams {
+            arena_size: DVec2::splat(1.0e5),
+            restitution: e,
+            ..default()
+        },
         &cluster(80, 5, 300.0),
     );
     record_collisions(&mut app);
     let radii: std::collections::HashMap<Entity, f64> = {
         let world = app.world_mut();
-        world.query::<(Entity, &Radius)>().iter(world).map(|(e, r)| (e, r.0)).collect()
+        world
+            .query::<(Entity, &Radius)>()
+            .iter(world)
+            .map(|(e, r)| (e, r.0))
+            .collect()
     };
     step(&mut app, 60);
     let hits = &app.world().resource::<Recorded>().ball_hits;
@@ -185,14 +256,29 @@ fn collision_messages_report_the_impulse_that_was_applied() {
 #[test]
 fn overlapping_balls_separate_and_do_not_stick() {
     // Deep overlap, at rest: pushed apart to touching in one step, lighter ball moving more.
-    let mut app = app_with(params(), &[ball(0.0, 0.0, 0.0, 0.0, 10.0), ball(6.0, 0.0, 0.0, 0.0, 30.0)]);
+    let mut app = app_with(
+        params(),
+        &[
+            ball(0.0, 0.0, 0.0, 0.0, 10.0),
+            ball(6.0, 0.0, 0.0, 0.0, 30.0),
+        ],
+    );
     step(&mut app, 1);
     let balls = states(&mut app);
     let gap = balls[1].position.x - balls[0].position.x;
     assert!((gap - 40.0).abs() < 1e-9, "gap {gap}");
-    assert!((balls[0].position.x + 25.5).abs() < 1e-9, "light ball takes 3/4 of the push");
+    assert!(
+        (balls[0].position.x + 25.5).abs() < 1e-9,
+        "light ball takes 3/4 of the push"
+    );
     // Overlapping but already separating: velocities untouched, and the pair comes apart.
-    let mut app = app_with(params(), &[ball(0.0, 0.0, -1.0, 0.0, 10.0), ball(15.0, 0.0, 1.0, 0.0, 10.0)]);
+    let mut app = app_with(
+        params(),
+        &[
+            ball(0.0, 0.0, -1.0, 0.0, 10.0),
+            ball(15.0, 0.0, 1.0, 0.0, 10.0),
+        ],
+    );
     record_collisions(&mut app);
     step(&mut app, 5);
     let balls = states(&mut app);
@@ -206,7 +292,13 @@ fn overlapping_balls_separate_and_do_not_stick() {
 fn a_slow_pair_bounces_once_instead_of_sticking() {
     // The tutorial's sticking bug: an overlapping pair flips velocities every step. Here it
     // bounces once and leaves.
-    let mut app = app_with(params(), &[ball(0.0, 0.0, 2.0, 0.0, 10.0), ball(19.0, 0.0, -2.0, 0.0, 10.0)]);
+    let mut app = app_with(
+        params(),
+        &[
+            ball(0.0, 0.0, 2.0, 0.0, 10.0),
+            ball(19.0, 0.0, -2.0, 0.0, 10.0),
+        ],
+    );
     step(&mut app, 120);
     let balls = states(&mut app);
     assert_eq!(app.world().resource::<SimStats>().ball_collisions, 1);
@@ -239,7 +331,13 @@ fn no_ball_ever_leaves_the_arena() {
 
 #[test]
 fn coincident_centres_give_no_nan() {
-    let mut app = app_with(params(), &[ball(5.0, 5.0, 0.0, 0.0, 10.0), ball(5.0, 5.0, 0.0, 0.0, 6.0)]);
+    let mut app = app_with(
+        params(),
+        &[
+            ball(5.0, 5.0, 0.0, 0.0, 10.0),
+            ball(5.0, 5.0, 0.0, 0.0, 6.0),
+        ],
+    );
     step(&mut app, 2);
     let balls = states(&mut app);
     for b in &balls {
@@ -270,14 +368,25 @@ fn grid_and_all_pairs_find_exactly_the_same_contacts() {
         let side = rng.random_range(50.0..600.0);
         let circles: Vec<Circle> = (0..count)
             .map(|_| {
-                let center = DVec2::new(rng.random_range(-side..side), rng.random_range(-side..side));
+                let center =
+                    DVec2::new(rng.random_range(-side..side), rng.random_range(-side..side));
                 Circle::new(center, rng.random_range(0.5..25.0))
             })
             .collect();
         let mut by_grid = Vec::new();
         let mut by_all_pairs = Vec::new();
-        find_contacts(&circles, BroadPhase::Grid, &mut UniformGrid::default(), &mut by_grid);
-        find_contacts(&circles, BroadPhase::AllPairs, &mut UniformGrid::default(), &mut by_all_pairs);
+        find_contacts(
+            &circles,
+            BroadPhase::Grid,
+            &mut UniformGrid::default(),
+            &mut by_grid,
+        );
+        find_contacts(
+            &circles,
+            BroadPhase::AllPairs,
+            &mut UniformGrid::default(),
+            &mut by_all_pairs,
+        );
         let key = |c: &ballpit::sim::collision::IndexedContact| (c.a, c.b);
         by_grid.sort_by_key(key);
         by_all_pairs.sort_by_key(key);
@@ -287,7 +396,13 @@ fn grid_and_all_pairs_find_exactly_the_same_contacts() {
 
 #[test]
 fn paused_simulation_does_not_move() {
-    let mut app = app_with(SimParams { paused: true, ..params() }, &[ball(0.0, 0.0, 50.0, 0.0, 5.0)]);
+    let mut app = app_with(
+        SimParams {
+            paused: true,
+            ..params()
+        },
+        &[ball(0.0, 0.0, 50.0, 0.0, 5.0)],
+    );
     step(&mut app, 10);
     assert_eq!(states(&mut app)[0].position, DVec2::ZERO);
     assert_eq!(app.world().resource::<SimStats>().steps, 0);

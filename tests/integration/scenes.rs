@@ -29,11 +29,22 @@ fn every_shipped_scene_loads() {
         .filter(|name| name.ends_with(".ron"))
         .collect();
     names.sort();
-    for name in ["billiards.ron", "gas.ron", "head_on.ron", "newtons_cradle.ron", "tutorial.ron"] {
-        assert!(names.iter().any(|n| n == name), "{name} missing from {names:?}");
+    for name in [
+        "billiards.ron",
+        "gas.ron",
+        "head_on.ron",
+        "newtons_cradle.ron",
+        "tutorial.ron",
+    ] {
+        assert!(
+            names.iter().any(|n| n == name),
+            "{name} missing from {names:?}"
+        );
     }
     for name in &names {
-        let setup = shipped_scene(name).build(name).unwrap_or_else(|e| panic!("{e}"));
+        let setup = shipped_scene(name)
+            .build(name)
+            .unwrap_or_else(|e| panic!("{e}"));
         assert!(!setup.balls.is_empty(), "{name} has no balls");
     }
 }
@@ -42,7 +53,11 @@ fn every_shipped_scene_loads() {
 fn the_standard_gas_matches_its_definition() {
     let setup = shipped_scene("gas.ron").build("gas.ron").unwrap();
     assert_eq!(setup.balls.len(), 1000);
-    let ball_area: f64 = setup.balls.iter().map(|b| std::f64::consts::PI * b.radius * b.radius).sum();
+    let ball_area: f64 = setup
+        .balls
+        .iter()
+        .map(|b| std::f64::consts::PI * b.radius * b.radius)
+        .sum();
     let arena = setup.params.arena_size;
     assert!((ball_area / (arena.x * arena.y) - 0.30).abs() < 1e-9);
     for b in &setup.balls {
@@ -55,7 +70,11 @@ fn the_standard_gas_matches_its_definition() {
 
 #[test]
 fn head_on_scene_is_the_worked_example() {
-    let (mut app, _) = run_scene(&shipped_scene("head_on.ron").build("head_on").unwrap(), 200, DT);
+    let (mut app, _) = run_scene(
+        &shipped_scene("head_on.ron").build("head_on").unwrap(),
+        200,
+        DT,
+    );
     let balls = states(&mut app);
     assert!((balls[0].velocity.x + 1.0).abs() < 1e-12);
     assert!((balls[1].velocity.x - 5.0).abs() < 1e-12);
@@ -77,7 +96,8 @@ fn optional_fields_take_their_defaults_and_some_is_optional() {
     assert_eq!(setup.params.restitution, 1.0);
     assert_eq!(setup.params.mass_model, MassModel::Radius);
     assert_eq!(setup.balls[0].velocity, DVec2::ZERO);
-    let with_some = build("(generate: Some((count: 5, radius: (2, 3), speed: (0, 1), seed: 4)))").unwrap();
+    let with_some =
+        build("(generate: Some((count: 5, radius: (2, 3), speed: (0, 1), seed: 4)))").unwrap();
     let without = build("(generate: (count: 5, radius: (2, 3), speed: (0, 1), seed: 4))").unwrap();
     assert_eq!(with_some, without);
 }
@@ -101,14 +121,22 @@ fn bad_radii_name_the_ball() {
         let message = error_of(&format!(
             "(balls: [(position: (0.0, 0.0), radius: 5.0), (position: (100.0, 0.0), radius: {radius})])"
         ));
-        assert!(message.starts_with("bad.ron: ball 1: radius"), "{radius}: {message}");
+        assert!(
+            message.starts_with("bad.ron: ball 1: radius"),
+            "{radius}: {message}"
+        );
     }
 }
 
 #[test]
 fn balls_outside_the_arena_or_overlapping_are_refused() {
-    let message = error_of("(arena: (width: 100.0, height: 100.0), balls: [(position: (45.0, 0.0), radius: 10.0)])");
-    assert!(message.contains("ball 0") && message.contains("outside"), "{message}");
+    let message = error_of(
+        "(arena: (width: 100.0, height: 100.0), balls: [(position: (45.0, 0.0), radius: 10.0)])",
+    );
+    assert!(
+        message.contains("ball 0") && message.contains("outside"),
+        "{message}"
+    );
     let message = error_of(
         "(balls: [(position: (0.0, 0.0), radius: 10.0), (position: (50.0, 0.0), radius: 5.0), \
           (position: (19.0, 0.0), radius: 10.0)])",
@@ -119,8 +147,9 @@ fn balls_outside_the_arena_or_overlapping_are_refused() {
 #[test]
 fn touching_balls_are_accepted() {
     // 1.65 - 0.55 rounds to a hair under 1.1: touching as written, accepted.
-    assert!(1.65_f64 - 0.55 < 1.1);
-    let setup = build("(balls: [(position: (0.55, 0.0), radius: 0.55), (position: (1.65, 0.0), radius: 0.55)])");
+    let setup = build(
+        "(balls: [(position: (0.55, 0.0), radius: 0.55), (position: (1.65, 0.0), radius: 0.55)])",
+    );
     assert!(setup.is_ok(), "{:?}", setup.err());
 }
 
@@ -132,10 +161,12 @@ fn more_balls_than_fit_give_a_message_not_a_hang() {
     );
     assert!(message.contains("no packing"), "{message}");
     // Possible in principle, beyond what random placement reaches.
-    let message = error_of("(generate: (count: 2000, radius: (5, 5), speed: (0, 0), area_fraction: 0.8))");
+    let message =
+        error_of("(generate: (count: 2000, radius: (5, 5), speed: (0, 0), area_fraction: 0.8))");
     assert!(message.contains("could not place"), "{message}");
     assert!(started.elapsed().as_secs() < 30);
-    let message = error_of("(generate: (count: 2000000, radius: (5, 5), speed: (0, 0), area_fraction: 0.3))");
+    let message =
+        error_of("(generate: (count: 2000000, radius: (5, 5), speed: (0, 0), area_fraction: 0.3))");
     assert!(message.contains("exceeds the limit"), "{message}");
 }
 
@@ -146,14 +177,23 @@ fn out_of_range_physics_is_refused() {
     assert!(error_of("(gravity: (0.0, NaN))").contains("gravity"));
     assert!(error_of("(linear_damping: -1.0)").contains("linear_damping"));
     assert!(error_of("(arena: (width: 0.0, height: 10.0))").contains("arena width"));
-    assert!(error_of("(generate: (count: 5, radius: (6, 5), speed: (0, 1)))").contains("radius max"));
-    assert!(error_of("(generate: (count: 5, radius: (5, 6), speed: (-1, 1)))").contains("speed min"));
+    assert!(
+        error_of("(generate: (count: 5, radius: (6, 5), speed: (0, 1)))").contains("radius max")
+    );
+    assert!(
+        error_of("(generate: (count: 5, radius: (5, 6), speed: (-1, 1)))").contains("speed min")
+    );
     let both = "(arena: (width: 10.0, height: 10.0), generate: (count: 1, radius: (1, 1), speed: (0, 0), area_fraction: 0.1))";
     assert!(error_of(both).contains("not both"));
 }
 
 #[test]
 fn missing_file_names_the_file() {
-    let error = SceneFile::load(Path::new("no/such/scene.ron")).unwrap_err().to_string();
-    assert!(error.starts_with("no/such/scene.ron: cannot read"), "{error}");
+    let error = SceneFile::load(Path::new("no/such/scene.ron"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.starts_with("no/such/scene.ron: cannot read"),
+        "{error}"
+    );
 }

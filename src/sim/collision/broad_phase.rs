@@ -96,12 +96,22 @@ impl UniformGrid {
                 for slot in here.clone() {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
                     for other in slot + 1..here.end {
-                        visit(index, self.sorted_index[other], circle, self.sorted_circle[other]);
+                        visit(
+                            index,
+                            self.sorted_index[other],
+                            circle,
+                            self.sorted_circle[other],
+                        );
                     }
                     for (dc, dr) in FORWARD_NEIGHBOURS {
                         let there = self.cell_range(column as isize + dc, row as isize + dr);
                         for other in there {
-                            visit(index, self.sorted_index[other], circle, self.sorted_circle[other]);
+                            visit(
+                                index,
+                                self.sorted_index[other],
+                                circle,
+                                self.sorted_circle[other],
+                            );
                         }
                     }
                 }
@@ -153,7 +163,10 @@ mod tests {
         let mut seen = std::collections::HashSet::new();
         grid.for_each_candidate_pair(|i, j, _, _| {
             assert_ne!(i, j);
-            assert!(seen.insert((i.min(j), i.max(j))), "pair ({i}, {j}) visited twice");
+            assert!(
+                seen.insert((i.min(j), i.max(j))),
+                "pair ({i}, {j}) visited twice"
+            );
         });
         // Every pair within one diameter must be among the candidates.
         for_each_pair(&circles, |i, j, a, b| {

@@ -9,9 +9,9 @@ pub mod narrow_phase;
 
 use bevy::prelude::*;
 
+use super::SimSystems;
 use super::ball::{Ball, Position, Radius};
 use super::params::{BroadPhase, SimParams};
-use super::SimSystems;
 use broad_phase::{UniformGrid, for_each_pair};
 use narrow_phase::{Circle, ContactGeometry, circle_contact};
 
@@ -55,7 +55,11 @@ pub fn find_contacts(
     found: &mut Vec<IndexedContact>,
 ) {
     let keep_touching = |i: u32, j: u32, ci: Circle, cj: Circle| {
-        let (a, b, ca, cb) = if i < j { (i, j, ci, cj) } else { (j, i, cj, ci) };
+        let (a, b, ca, cb) = if i < j {
+            (i, j, ci, cj)
+        } else {
+            (j, i, cj, ci)
+        };
         if let Some(geometry) = circle_contact(ca, cb) {
             found.push(IndexedContact { a, b, geometry });
         }
@@ -84,7 +88,12 @@ fn detect_contacts(
     mut scratch: ResMut<CollisionScratch>,
     mut contacts: ResMut<Contacts>,
 ) {
-    let CollisionScratch { entities, circles, grid, found } = &mut *scratch;
+    let CollisionScratch {
+        entities,
+        circles,
+        grid,
+        found,
+    } = &mut *scratch;
     entities.clear();
     circles.clear();
     for (entity, position, radius) in &balls {

@@ -119,7 +119,10 @@ mod tests {
         let c = circle_contact(circle(0.0, 0.0, 10.0), circle(20.0, 0.0, 10.0)).unwrap();
         assert_eq!(c.depth, 0.0);
         assert_eq!(c.point, DVec2::new(10.0, 0.0));
-        assert_eq!(circle_contact(circle(0.0, 0.0, 10.0), circle(20.001, 0.0, 10.0)), None);
+        assert_eq!(
+            circle_contact(circle(0.0, 0.0, 10.0), circle(20.001, 0.0, 10.0)),
+            None
+        );
     }
 
     #[test]
