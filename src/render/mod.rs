@@ -21,7 +21,9 @@ const BACKGROUND: Color = Color::srgb(0.06, 0.07, 0.09);
 
 pub fn plugin(app: &mut App) {
     app.insert_resource(ClearColor(BACKGROUND))
-        .add_systems(Startup, (spawn_camera, make_circle_texture))
+        // The texture must exist before any scene's balls are spawned (in `Startup`).
+        .add_systems(PreStartup, make_circle_texture)
+        .add_systems(Startup, spawn_camera)
         .add_observer(give_ball_a_sprite)
         .add_systems(Update, fit_arena_to_window)
         .add_systems(
