@@ -282,13 +282,7 @@ impl SceneFile {
             }
             (Some(arena), None) => DVec2::new(arena.width, arena.height),
             (None, Some(fraction)) => {
-                let ball_area: f64 = hand_placed
-                    .iter()
-                    .map(|b| b.radius)
-                    .chain(drawn.iter().map(|b| b.radius))
-                    .map(|r| std::f64::consts::PI * r * r)
-                    .sum();
-                DVec2::splat((ball_area / fraction).sqrt())
+                DVec2::splat((total_disc_area(hand_placed, drawn) / fraction).sqrt())
             }
             (None, None) => DEFAULT_ARENA,
         };
@@ -341,6 +335,23 @@ struct DrawnBall {
     velocity: DVec2,
 }
 
+fn radii<'a>(
+    hand_placed: &'a [BallState],
+    drawn: &'a [DrawnBall],
+) -> impl Iterator<Item = f64> + 'a {
+    hand_placed
+        .iter()
+        .map(|b| b.radius)
+        .chain(drawn.iter().map(|b| b.radius))
+}
+
+/// Total area of all the balls' discs, square pixels.
+fn total_disc_area(hand_placed: &[BallState], drawn: &[DrawnBall]) -> f64 {
+    radii(hand_placed, drawn)
+        .map(|r| std::f64::consts::PI * r * r)
+        .sum()
+}
+
 fn check_range(
     name: &str,
     value: f64,
@@ -366,13 +377,7 @@ fn place_balls(
     rng: &mut ChaCha8Rng,
 ) -> Result<Vec<BallState>, String> {
     let half = arena_size * 0.5;
-    let ball_area: f64 = hand_placed
-        .iter()
-        .map(|b| b.radius)
-        .chain(drawn.iter().map(|b| b.radius))
-        .map(|r| std::f64::consts::PI * r * r)
-        .sum();
-    let covered = ball_area / (arena_size.x * arena_size.y);
+    let covered = total_disc_area(&hand_placed, &drawn) / (arena_size.x * arena_size.y);
     if covered > DENSEST_PACKING {
         return Err(format!(
             "the balls would cover {:.0}% of the {} x {} arena; no packing of discs exceeds {:.1}%",
@@ -382,11 +387,7 @@ fn place_balls(
             DENSEST_PACKING * 100.0
         ));
     }
-    let largest_radius = hand_placed
-        .iter()
-        .map(|b| b.radius)
-        .chain(drawn.iter().map(|b| b.radius))
-        .fold(0.0, f64::max);
+    let largest_radius = radii(&hand_placed, &drawn).fold(0.0, f64::max);
     let total = hand_placed.len() + drawn.len();
     let mut grid = PlacementGrid::new(half, largest_radius, total);
     let mut balls = Vec::with_capacity(total);
