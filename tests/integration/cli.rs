@@ -157,30 +157,38 @@ fn usage_errors_exit_2() {
 }
 
 #[test]
-fn runtime_errors_exit_1_with_the_file_named() {
-    let out = ballpit(&["run", "--scene", "no/such.ron", "--steps", "1"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such.ron"));
-    let out = ballpit(&[
-        "run",
-        "--scene",
-        "assets/scenes/head_on.ron",
-        "--steps",
-        "1",
-        "--balls",
-        "10",
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("lacks"));
-    let out = ballpit(&[
-        "run",
-        "--scene",
-        "assets/scenes/gas.ron",
-        "--steps",
-        "1",
-        "--balls",
-        "100000000",
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("limit"));
+fn runtime_errors_exit_1_naming_the_cause() {
+    for (args, expected) in [
+        (
+            &["--scene", "no/such.ron", "--steps", "1"][..],
+            "no/such.ron: cannot read",
+        ),
+        (
+            &[
+                "--scene",
+                "assets/scenes/head_on.ron",
+                "--steps",
+                "1",
+                "--balls",
+                "10",
+            ],
+            "lacks",
+        ),
+        (
+            &[
+                "--scene",
+                "assets/scenes/gas.ron",
+                "--steps",
+                "1",
+                "--balls",
+                "100000000",
+            ],
+            "limit",
+        ),
+    ] {
+        let out = ballpit(&[&["run"], args].concat());
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
 }

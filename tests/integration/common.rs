@@ -50,6 +50,16 @@ pub fn states(app: &mut App) -> Vec<BallState> {
     balls.into_iter().map(|(_, state)| state).collect()
 }
 
+/// Every ball's radius by entity, to look up the balls a collision message names.
+pub fn radii_by_entity(app: &mut App) -> std::collections::HashMap<Entity, f64> {
+    let world = app.world_mut();
+    world
+        .query::<(Entity, &Radius)>()
+        .iter(world)
+        .map(|(e, r)| (e, r.0))
+        .collect()
+}
+
 /// Runs `steps` fixed steps.
 pub fn step(app: &mut App, steps: usize) {
     for _ in 0..steps {

@@ -185,14 +185,7 @@ fn every_hit_loses_exactly_the_restitution_share_of_energy() {
     );
     record_collisions(&mut app);
     let (_, energy_start) = momentum_and_energy(&mut app);
-    let masses: std::collections::HashMap<Entity, f64> = {
-        let world = app.world_mut();
-        world
-            .query::<(Entity, &Radius)>()
-            .iter(world)
-            .map(|(e, r)| (e, r.0))
-            .collect()
-    };
+    let masses = radii_by_entity(&mut app); // mass = radius
     step(&mut app, 90);
     let (_, energy_end) = momentum_and_energy(&mut app);
     let recorded = app.world().resource::<Recorded>();
@@ -233,14 +226,7 @@ fn collision_messages_report_the_impulse_that_was_applied() {
         &cluster(80, 5, 300.0),
     );
     record_collisions(&mut app);
-    let radii: std::collections::HashMap<Entity, f64> = {
-        let world = app.world_mut();
-        world
-            .query::<(Entity, &Radius)>()
-            .iter(world)
-            .map(|(e, r)| (e, r.0))
-            .collect()
-    };
+    let radii = radii_by_entity(&mut app);
     step(&mut app, 60);
     let hits = &app.world().resource::<Recorded>().ball_hits;
     assert!(hits.len() > 20, "only {} hits", hits.len());
