@@ -17,6 +17,7 @@ pub mod collision;
 pub mod messages;
 pub mod movement;
 pub mod params;
+pub mod placement;
 pub mod response;
 pub mod scene;
 pub mod stats;

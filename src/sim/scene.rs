@@ -29,6 +29,7 @@ use super::params::{
     ARENA_SIDE_RANGE, DAMPING_RANGE, MAX_BALLS, MAX_GRAVITY, MAX_SPEED, MassModel, RADIUS_RANGE,
     RESTITUTION_RANGE, SimParams,
 };
+use super::placement::PlacementGrid;
 use super::stats::SimStats;
 
 /// Largest scene file read, bytes (a million hand-written balls fit in about 80 MB).
@@ -39,9 +40,6 @@ pub const DENSEST_PACKING: f64 = 0.906_899_682;
 pub const DEFAULT_ARENA: DVec2 = DVec2::new(800.0, 600.0);
 /// Random placement gives up on a ball after this many overlapping tries in a row.
 const PLACEMENT_TRIES_PER_BALL: u32 = 2_000;
-/// Two balls overlap when they interpenetrate by more than this fraction of their radii sum,
-/// so hand-written decimals that touch (Newton's cradle) are accepted.
-const OVERLAP_TOLERANCE: f64 = 1e-9;
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<SimRng>().init_resource::<NextBallId>();
@@ -415,15 +413,8 @@ fn place_balls(
                 ball.radius, arena_size.x, arena_size.y
             ));
         }
-        let spot = (0..PLACEMENT_TRIES_PER_BALL).find_map(|_| {
-            let position = DVec2::new(
-                rng.random_range(-limit.x..=limit.x),
-                rng.random_range(-limit.y..=limit.y),
-            );
-            let circle = Circle::new(position, ball.radius);
-            grid.first_overlap(circle).is_none().then_some(circle)
-        });
-        let Some(circle) = spot else {
+        let spot = grid.random_free_spot(ball.radius, half, rng, PLACEMENT_TRIES_PER_BALL);
+        let Some(position) = spot else {
             return Err(format!(
                 "could not place generated ball {k} of {total} (ball {index}) without overlap after \
                  {PLACEMENT_TRIES_PER_BALL} tries: the balls cover {:.0}% of the arena, and random \
@@ -431,87 +422,14 @@ fn place_balls(
                 covered * 100.0
             ));
         };
-        grid.insert(circle);
+        grid.insert(Circle::new(position, ball.radius));
         balls.push(BallState {
-            position: circle.center,
+            position,
             velocity: ball.velocity,
             radius: ball.radius,
         });
     }
     Ok(balls)
-}
-
-fn overlapping(a: Circle, b: Circle) -> bool {
-    let reach = a.radius + b.radius;
-    let distance = a.center.distance(b.center);
-    reach - distance > OVERLAP_TOLERANCE * reach
-}
-
-/// An incremental grid for placement: cells hold linked lists of the balls placed so far.
-struct PlacementGrid {
-    origin: DVec2,
-    cell_size: f64,
-    columns: usize,
-    rows: usize,
-    /// First ball in each cell, or `u32::MAX`.
-    head: Vec<u32>,
-    /// Next ball in the same cell, per ball.
-    next: Vec<u32>,
-    circles: Vec<Circle>,
-}
-
-impl PlacementGrid {
-    fn new(half: DVec2, largest_radius: f64, capacity: usize) -> Self {
-        let size = half * 2.0;
-        let max_cells = (4 * capacity).max(16) as f64;
-        let cell_size = (2.0 * largest_radius)
-            .max((size.x * size.y / max_cells).sqrt())
-            .max(f64::MIN_POSITIVE);
-        let columns = ((size.x / cell_size) as usize).saturating_add(1);
-        let rows = ((size.y / cell_size) as usize).saturating_add(1);
-        PlacementGrid {
-            origin: -half,
-            cell_size,
-            columns,
-            rows,
-            head: vec![u32::MAX; columns * rows],
-            next: Vec::with_capacity(capacity),
-            circles: Vec::with_capacity(capacity),
-        }
-    }
-
-    fn cell_of(&self, point: DVec2) -> (usize, usize) {
-        let cell = (point - self.origin) / self.cell_size;
-        (
-            (cell.x.max(0.0) as usize).min(self.columns - 1),
-            (cell.y.max(0.0) as usize).min(self.rows - 1),
-        )
-    }
-
-    /// The index of a placed ball that overlaps `circle`, if any.
-    fn first_overlap(&self, circle: Circle) -> Option<usize> {
-        let (column, row) = self.cell_of(circle.center);
-        for r in row.saturating_sub(1)..=(row + 1).min(self.rows - 1) {
-            for c in column.saturating_sub(1)..=(column + 1).min(self.columns - 1) {
-                let mut ball = self.head[r * self.columns + c];
-                while ball != u32::MAX {
-                    if overlapping(self.circles[ball as usize], circle) {
-                        return Some(ball as usize);
-                    }
-                    ball = self.next[ball as usize];
-                }
-            }
-        }
-        None
-    }
-
-    fn insert(&mut self, circle: Circle) {
-        let (column, row) = self.cell_of(circle.center);
-        let cell = row * self.columns + column;
-        self.next.push(self.head[cell]);
-        self.head[cell] = self.circles.len() as u32;
-        self.circles.push(circle);
-    }
 }
 
 impl SceneSetup {
@@ -552,25 +470,6 @@ impl SceneSetup {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn placement_grid_finds_overlaps_across_cells() {
-        let mut grid = PlacementGrid::new(DVec2::splat(100.0), 5.0, 10);
-        grid.insert(Circle::new(DVec2::new(9.0, 9.0), 5.0));
-        assert_eq!(
-            grid.first_overlap(Circle::new(DVec2::new(17.0, 9.0), 5.0)),
-            Some(0)
-        );
-        assert_eq!(
-            grid.first_overlap(Circle::new(DVec2::new(19.0, 9.0), 5.0)),
-            None
-        );
-        // Just touching is allowed.
-        assert_eq!(
-            grid.first_overlap(Circle::new(DVec2::new(9.0, 19.0), 5.0)),
-            None
-        );
-    }
 
     #[test]
     fn area_fraction_sets_a_square_arena() {

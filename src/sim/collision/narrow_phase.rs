@@ -80,6 +80,32 @@ pub fn circle_contact(a: Circle, b: Circle) -> Option<ContactGeometry> {
     })
 }
 
+/// Seconds until two circles moving at constant velocities first touch, or `None` if they
+/// never do. Pairs that already touch count as touching now (`Some(0.0)`) only while they
+/// approach; a separating pair gives `None`.
+///
+/// Solves `|d + v t|^2 = (r1 + r2)^2` for the smaller root, written as `c / (-b + sqrt(disc))`
+/// so the subtraction of nearly equal terms in the textbook form cannot lose precision.
+#[inline]
+pub fn time_of_impact(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2) -> Option<f64> {
+    let offset = b.center - a.center;
+    let velocity = velocity_b - velocity_a;
+    let reach = a.radius + b.radius;
+    let half_b = offset.dot(velocity);
+    if half_b >= 0.0 {
+        return None; // not approaching
+    }
+    let c = offset.length_squared() - reach * reach;
+    if c <= 0.0 {
+        return Some(0.0);
+    }
+    let discriminant = half_b * half_b - velocity.length_squared() * c;
+    if discriminant < 0.0 {
+        return None; // they pass each other
+    }
+    Some(c / (-half_b + discriminant.sqrt()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,6 +149,40 @@ mod tests {
             circle_contact(circle(0.0, 0.0, 10.0), circle(20.001, 0.0, 10.0)),
             None
         );
+    }
+
+    #[test]
+    fn time_of_impact_head_on_and_glancing() {
+        let a = circle(0.0, 0.0, 1.0);
+        let b = circle(10.0, 0.0, 1.0);
+        // Closing at 4 px/s over a gap of 8 px.
+        let t = time_of_impact(a, DVec2::new(3.0, 0.0), b, DVec2::new(-1.0, 0.0)).unwrap();
+        assert!((t - 2.0).abs() < 1e-12);
+        // Offset by 1.5 (< reach 2): they touch when the x gap is sqrt(4 - 2.25).
+        let b = circle(10.0, 1.5, 1.0);
+        let t = time_of_impact(a, DVec2::new(1.0, 0.0), b, DVec2::ZERO).unwrap();
+        assert!((t - (10.0 - 1.75f64.sqrt())).abs() < 1e-12);
+        // Offset by 2.5 (> reach): a miss.
+        assert_eq!(
+            time_of_impact(a, DVec2::X, circle(10.0, 2.5, 1.0), DVec2::ZERO),
+            None
+        );
+    }
+
+    #[test]
+    fn time_of_impact_of_touching_and_separating_pairs() {
+        let (a, b) = (circle(0.0, 0.0, 1.0), circle(1.5, 0.0, 1.0));
+        assert_eq!(time_of_impact(a, DVec2::X, b, DVec2::ZERO), Some(0.0));
+        assert_eq!(time_of_impact(a, -DVec2::X, b, DVec2::ZERO), None);
+        assert_eq!(time_of_impact(a, DVec2::ZERO, b, DVec2::ZERO), None);
+    }
+
+    #[test]
+    fn time_of_impact_keeps_precision_for_a_tiny_gap_at_high_speed() {
+        let a = circle(0.0, 0.0, 10.0);
+        let b = circle(20.0 + 1e-9, 0.0, 10.0);
+        let t = time_of_impact(a, DVec2::new(1.0e4, 0.0), b, DVec2::ZERO).unwrap();
+        assert!((t - 1e-13).abs() < 1e-17, "{t}");
     }
 
     #[test]
