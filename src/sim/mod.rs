@@ -12,6 +12,7 @@
 //! Data flows one way: components → contacts → components, and outward as
 //! [`BallCollision`] / [`WallCollision`] messages.
 
+pub mod aim;
 pub mod ball;
 pub mod collision;
 pub mod messages;
