@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
-#[require(BallId, Position, Velocity, Radius)]
+#[require(BallId, Position, PreviousPosition, Velocity, Radius)]
 pub struct Ball;
 
 /// A ball's stable number, in spawn order: what reports and dumps call it.
@@ -19,6 +19,10 @@ pub struct BallId(pub u32);
 /// Centre of the ball, pixels, arena coordinates (origin at the arena's centre, y up).
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Deref, DerefMut)]
 pub struct Position(pub DVec2);
+
+/// The centre at the start of the latest fixed step, for drawing between steps.
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Deref, DerefMut)]
+pub struct PreviousPosition(pub DVec2);
 
 /// Pixels per second.
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Deref, DerefMut)]
@@ -55,11 +59,15 @@ impl NextBallId {
 }
 
 /// The components that make `state` a simulated ball with number `id`.
-pub fn ball_bundle(id: BallId, state: BallState) -> (Ball, BallId, Position, Velocity, Radius) {
+pub fn ball_bundle(
+    id: BallId,
+    state: BallState,
+) -> (Ball, BallId, Position, PreviousPosition, Velocity, Radius) {
     (
         Ball,
         id,
         Position(state.position),
+        PreviousPosition(state.position),
         Velocity(state.velocity),
         Radius(state.radius),
     )

@@ -21,15 +21,17 @@ pub mod params;
 pub mod placement;
 pub mod response;
 pub mod scene;
+pub mod spawn;
 pub mod stats;
 
 use bevy::prelude::*;
 
-pub use ball::{Ball, BallId, BallState, Position, Radius, Velocity};
+pub use ball::{Ball, BallId, BallState, Position, PreviousPosition, Radius, Velocity};
 pub use collision::{Contact, Contacts};
 pub use messages::{BallCollision, Wall, WallCollision};
 pub use params::{BroadPhase, MassModel, SimParams};
 pub use scene::{SceneError, SceneFile, SceneSetup, SimRng};
+pub use spawn::SpawnSettings;
 pub use stats::{SimStats, StateSummary};
 
 /// The simulation's stages, run in this order every fixed step.
@@ -51,6 +53,7 @@ pub struct SimPlugin;
 impl Plugin for SimPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<SimParams>()
+            .init_resource::<PendingSteps>()
             .add_message::<BallCollision>()
             .add_message::<WallCollision>()
             .configure_sets(
@@ -70,12 +73,27 @@ impl Plugin for SimPlugin {
                 response::plugin,
                 stats::plugin,
                 scene::plugin,
-            ));
+                spawn::plugin,
+            ))
+            .add_systems(
+                FixedUpdate,
+                take_pending_step.in_set(SimSystems::Bookkeeping),
+            );
     }
 }
 
-fn simulation_running(params: Res<SimParams>) -> bool {
-    !params.paused
+/// Steps to run although the simulation is paused: the panel's and the N key's single step.
+#[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct PendingSteps(pub u32);
+
+fn simulation_running(params: Res<SimParams>, pending: Res<PendingSteps>) -> bool {
+    !params.paused || pending.0 > 0
+}
+
+fn take_pending_step(params: Res<SimParams>, mut pending: ResMut<PendingSteps>) {
+    if params.paused {
+        pending.0 = pending.0.saturating_sub(1);
+    }
 }
 
 /// Simulated seconds in this fixed step: the fixed timestep scaled by `time_scale`.

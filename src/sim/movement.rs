@@ -7,7 +7,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{Ball, Position, Radius, Velocity};
+use super::ball::{Ball, Position, PreviousPosition, Radius, Velocity};
 use super::messages::{Wall, WallCollision};
 use super::params::SimParams;
 use super::{SimSystems, step_seconds};
@@ -15,7 +15,7 @@ use super::{SimSystems, step_seconds};
 pub(super) fn plugin(app: &mut App) {
     app.add_systems(
         FixedUpdate,
-        (integrate_motion, bounce_off_walls)
+        (remember_positions, integrate_motion, bounce_off_walls)
             .chain()
             .in_set(SimSystems::Movement),
     );
@@ -107,6 +107,12 @@ pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
         Wall::Bottom => DVec2::new(position.x, -half.y),
         Wall::Top => DVec2::new(position.x, half.y),
     }
+}
+
+fn remember_positions(mut balls: Query<(&Position, &mut PreviousPosition), With<Ball>>) {
+    balls
+        .par_iter_mut()
+        .for_each(|(position, mut previous)| previous.0 = position.0);
 }
 
 fn integrate_motion(

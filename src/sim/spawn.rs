@@ -1,0 +1,177 @@
+//! Adding and removing balls in a running simulation: the ball-count slider grows or shrinks
+//! the population, a click puts a ball in free space. World functions that the UI queues as
+//! commands, and the pure geometry behind them; no systems of their own.
+
+use std::ops::RangeInclusive;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use rand::RngExt;
+
+use super::ball::{Ball, BallId, BallState, NextBallId, Position, Radius, ball_bundle};
+use super::collision::narrow_phase::Circle;
+use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, SimParams};
+use super::placement::PlacementGrid;
+use super::scene::SimRng;
+
+/// Random placement tries per added ball before the arena counts as full.
+const PLACEMENT_TRIES: u32 = 200;
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<SpawnSettings>();
+}
+
+/// Radius and speed ranges for balls added while running (the count slider, clicks).
+#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq)]
+#[reflect(Resource)]
+pub struct SpawnSettings {
+    /// (min, max) pixels.
+    pub radius: (f64, f64),
+    /// (min, max) pixels per second.
+    pub speed: (f64, f64),
+}
+
+impl Default for SpawnSettings {
+    fn default() -> Self {
+        SpawnSettings {
+            radius: (10.0, 40.0),
+            speed: (100.0, 350.0),
+        }
+    }
+}
+
+impl SpawnSettings {
+    /// Brings both ranges within the accepted limits, min never above max, NaN to defaults.
+    pub fn clamp_to_limits(&mut self) {
+        let defaults = SpawnSettings::default();
+        self.radius = clamp_range(self.radius, &RADIUS_RANGE, defaults.radius);
+        self.speed = clamp_range(self.speed, &(0.0..=MAX_SPEED), defaults.speed);
+    }
+}
+
+fn clamp_range(
+    range: (f64, f64),
+    limits: &RangeInclusive<f64>,
+    fallback: (f64, f64),
+) -> (f64, f64) {
+    if !(range.0.is_finite() && range.1.is_finite()) {
+        return fallback;
+    }
+    let low = range.0.clamp(*limits.start(), *limits.end());
+    (low, range.1.clamp(low, *limits.end()))
+}
+
+/// Spawns one ball with the next id.
+pub fn spawn_ball(world: &mut World, state: BallState) -> Entity {
+    let id = world.resource_mut::<NextBallId>().take();
+    world.spawn(ball_bundle(id, state)).id()
+}
+
+/// Adds or removes balls until there are `target` (at most [`MAX_BALLS`]). Removes the newest
+/// first; adds balls with radius and velocity drawn from [`SpawnSettings`] at random free
+/// spots. Returns how many balls there are afterwards: fewer than asked when the arena is full.
+pub fn set_ball_count(world: &mut World, target: usize) -> usize {
+    let target = target.min(MAX_BALLS);
+    let mut balls: Vec<(BallId, Entity, Circle)> = world
+        .query_filtered::<(&BallId, Entity, &Position, &Radius), With<Ball>>()
+        .iter(world)
+        .map(|(id, entity, position, radius)| (*id, entity, Circle::new(position.0, radius.0)))
+        .collect();
+    if balls.len() >= target {
+        balls.sort_by_key(|(id, _, _)| *id);
+        for (_, entity, _) in balls.drain(target..) {
+            world.despawn(entity);
+        }
+        return target;
+    }
+    let half = world.resource::<SimParams>().half_extents();
+    let settings = *world.resource::<SpawnSettings>();
+    let largest = balls
+        .iter()
+        .map(|(_, _, c)| c.radius)
+        .fold(settings.radius.1, f64::max);
+    let mut grid = PlacementGrid::new(half, largest, target);
+    for (_, _, circle) in &balls {
+        grid.insert(*circle);
+    }
+    let mut count = balls.len();
+    let mut rng = world.resource_mut::<SimRng>().0.clone();
+    while count < target {
+        let radius = rng.random_range(settings.radius.0..=settings.radius.1);
+        let Some(position) = grid.random_free_spot(radius, half, &mut rng, PLACEMENT_TRIES) else {
+            break;
+        };
+        let speed = rng.random_range(settings.speed.0..=settings.speed.1);
+        let velocity = DVec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)) * speed;
+        grid.insert(Circle::new(position, radius));
+        spawn_ball(
+            world,
+            BallState {
+                position,
+                velocity,
+                radius,
+            },
+        );
+        count += 1;
+    }
+    world.resource_mut::<SimRng>().0 = rng;
+    count
+}
+
+/// The radius of a ball centred at `point` that fits in the arena `[-half, half]` without
+/// overlapping any of `nearby`: `wanted` when there is room, smaller when not, `None` when
+/// not even the smallest ball fits.
+pub fn fit_radius_at(
+    point: DVec2,
+    wanted: f64,
+    half: DVec2,
+    nearby: impl IntoIterator<Item = Circle>,
+) -> Option<f64> {
+    let to_walls = (half - point.abs()).min_element();
+    let room = nearby
+        .into_iter()
+        .map(|circle| circle.center.distance(point) - circle.radius)
+        .fold(to_walls, f64::min);
+    let radius = wanted.min(room);
+    (radius >= *RADIUS_RANGE.start()).then_some(radius)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fit_radius_shrinks_to_the_room_available() {
+        let half = DVec2::splat(100.0);
+        let others = [Circle::new(DVec2::new(30.0, 0.0), 10.0)];
+        assert_eq!(fit_radius_at(DVec2::ZERO, 15.0, half, others), Some(15.0));
+        assert_eq!(fit_radius_at(DVec2::ZERO, 25.0, half, others), Some(20.0));
+        assert_eq!(
+            fit_radius_at(DVec2::new(95.0, 0.0), 25.0, half, []),
+            Some(5.0)
+        );
+        assert_eq!(
+            fit_radius_at(DVec2::new(25.0, 0.0), 25.0, half, others),
+            None
+        );
+        assert_eq!(fit_radius_at(DVec2::new(300.0, 0.0), 5.0, half, []), None);
+    }
+
+    #[test]
+    fn clamped_ranges_are_ordered_and_finite() {
+        let mut settings = SpawnSettings {
+            radius: (50.0, 2.0),
+            speed: (f64::NAN, 3.0),
+        };
+        settings.clamp_to_limits();
+        assert_eq!(settings.radius, (50.0, 50.0));
+        assert_eq!(settings.speed, SpawnSettings::default().speed);
+        let mut settings = SpawnSettings {
+            radius: (0.0, 1e9),
+            speed: (-5.0, 1e12),
+        };
+        settings.clamp_to_limits();
+        assert_eq!(settings.radius, (0.5, 1000.0));
+        assert_eq!(settings.speed, (0.0, MAX_SPEED));
+    }
+}
