@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::headless::{DEFAULT_DT, StateDump, run_scene};
-use crate::play::{PlayOptions, play};
+use crate::play::{CurrentScene, PlayOptions, play};
 use crate::sim::SceneFile;
 
 /// The scene played when no `--scene` is given, built in so it works from any directory.
@@ -104,16 +104,20 @@ impl Cli {
 }
 
 fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
-    let (scene, origin) = match &args.scene {
+    let (file, origin) = match &args.scene {
         Some(path) => (SceneFile::load(path)?, path.display().to_string()),
         None => (
             SceneFile::parse(DEMO_SCENE, "demo.ron")?,
             "demo.ron".to_string(),
         ),
     };
-    let setup = scene.build(&origin)?;
+    // Refuse a bad scene here, with exit code 1, rather than in the window.
+    file.build(&origin)?;
     let screenshot = args.screenshot.map(|path| (path, args.frames));
-    match play(PlayOptions { setup, screenshot }) {
+    match play(PlayOptions {
+        scene: CurrentScene { file, origin },
+        screenshot,
+    }) {
         bevy::app::AppExit::Success => Ok(()),
         bevy::app::AppExit::Error(code) => Err(format!("the game exited with code {code}").into()),
     }

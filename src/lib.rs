@@ -4,6 +4,7 @@
 //!   movement → collision → response, in `FixedUpdate`.
 //! - [`headless`]: step a scene without a window and measure it.
 //! - [`render`]: drawing the simulation in a window (reads its state only).
+//! - [`ui`]: the egui panel, mouse and keys.
 //! - [`play`]: the windowed toy.
 //! - [`cli`]: the `ballpit` command line.
 
@@ -12,6 +13,7 @@ pub mod headless;
 pub mod play;
 pub mod render;
 pub mod sim;
+pub mod ui;
 
 /// The types most users of the crate need.
 pub mod prelude {

@@ -1,40 +1,73 @@
-//! The windowed toy: default plugins, the simulation and its rendering, a scene loaded at
-//! start-up, and optionally a screenshot after a number of frames (for checks under Xvfb).
+//! The windowed toy: default plugins, the simulation, its rendering and its UI; the scene being
+//! played and requests to reset, reseed or switch it; optionally a screenshot after a number
+//! of frames (for the README and for checks under Xvfb).
+//!
+//! Scene requests arrive as [`SceneRequest`] messages (from the panel and the keys) and are
+//! applied as world commands in `Update`. A scene that fails to load leaves the current one
+//! playing and its error in [`SceneStatus`].
 
 use std::path::PathBuf;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
-use bevy::window::WindowResolution;
+use bevy::window::{PrimaryWindow, WindowResolution};
+use rand::RngExt;
 
-use crate::render;
-use crate::sim::{SceneSetup, SimPlugin};
+use crate::render::{self, PlayArea};
+use crate::sim::{SceneFile, SimPlugin, SimRng};
+use crate::ui;
 
-/// Largest window the play command opens, logical pixels; a larger arena is fitted to it.
+/// Largest window the toy opens or resizes to, logical pixels.
 const MAX_WINDOW: Vec2 = Vec2::new(1600.0, 1000.0);
+/// Smallest window the toy resizes to for a scene, logical pixels.
+const MIN_WINDOW: Vec2 = Vec2::new(640.0, 400.0);
+/// Fixed steps per second.
+const DEFAULT_STEP_RATE: f64 = 60.0;
 
 /// What to play and whether to take a screenshot and quit.
 pub struct PlayOptions {
-    pub setup: SceneSetup,
+    pub scene: CurrentScene,
     /// Save a PNG of the window after `frames` frames, then exit.
     pub screenshot: Option<(PathBuf, u32)>,
 }
 
+/// The scene being played, as a file (so reset and reseed rebuild it), and its name.
+#[derive(Resource, Clone, Debug, PartialEq)]
+pub struct CurrentScene {
+    pub file: SceneFile,
+    pub origin: String,
+}
+
+/// What the player asked to do with the scene.
+#[derive(Message, Clone, Debug, PartialEq)]
+pub enum SceneRequest {
+    /// Rebuild the current scene with the same seed.
+    Reset,
+    /// Rebuild the current scene with a new random seed.
+    NewSeed,
+    /// Switch to the scene file at this path.
+    Load(PathBuf),
+}
+
+/// The last scene error, shown in the panel until a scene loads.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct SceneStatus(pub Option<String>);
+
 /// Opens the window and runs until it is closed (or the screenshot is saved).
 pub fn play(options: PlayOptions) -> AppExit {
-    let arena = options.setup.params.arena_size.as_vec2().min(MAX_WINDOW);
+    let window = window_size_for(&options.scene);
     let mut app = App::new();
     app.add_plugins(DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {
             title: "ballpit".into(),
-            resolution: WindowResolution::new(arena.x as u32, arena.y as u32),
+            resolution: WindowResolution::new(window.x as u32, window.y as u32),
             ..default()
         }),
         ..default()
     }))
-    .add_plugins((SimPlugin, render::plugin))
-    .insert_resource(SceneToLoad(options.setup))
-    .add_systems(Startup, load_scene);
+    .add_plugins(GamePlugin)
+    .insert_resource(options.scene);
     if let Some((path, frames)) = options.screenshot {
         app.insert_resource(ScreenshotPlan {
             path,
@@ -46,12 +79,86 @@ pub fn play(options: PlayOptions) -> AppExit {
     app.run()
 }
 
-#[derive(Resource)]
-struct SceneToLoad(SceneSetup);
+/// The whole toy but the window and rendering backends: the simulation at 60 steps per
+/// second, its rendering, the panel and input, and scene requests. The scene to play comes
+/// in a [`CurrentScene`] resource; it is loaded at start-up.
+pub struct GamePlugin;
 
-fn load_scene(world: &mut World) {
-    if let Some(SceneToLoad(setup)) = world.remove_resource::<SceneToLoad>() {
-        setup.apply(world);
+impl Plugin for GamePlugin {
+    fn build(&self, app: &mut App) {
+        app.add_plugins((SimPlugin, render::plugin, ui::plugin))
+            .insert_resource(Time::<Fixed>::from_hz(DEFAULT_STEP_RATE))
+            .add_message::<SceneRequest>()
+            .init_resource::<SceneStatus>()
+            .add_systems(Startup, |mut requests: MessageWriter<SceneRequest>| {
+                requests.write(SceneRequest::Reset);
+            })
+            .add_systems(Update, handle_scene_requests);
+    }
+}
+
+/// The window that shows `scene`'s arena beside the panel, within the size limits.
+fn window_size_for(scene: &CurrentScene) -> Vec2 {
+    let arena = scene
+        .file
+        .build(&scene.origin)
+        .map_or(Vec2::new(1280.0, 720.0), |setup| {
+            setup.params.arena_size.as_vec2()
+        });
+    (arena + Vec2::new(ui::PANEL_WIDTH, 0.0)).clamp(MIN_WINDOW, MAX_WINDOW)
+}
+
+fn handle_scene_requests(mut requests: MessageReader<SceneRequest>, mut commands: Commands) {
+    for request in requests.read().cloned() {
+        commands.queue(move |world: &mut World| apply_scene_request(world, request));
+    }
+}
+
+fn apply_scene_request(world: &mut World, request: SceneRequest) {
+    let mut scene = world.resource::<CurrentScene>().clone();
+    match request {
+        SceneRequest::Reset => {}
+        SceneRequest::NewSeed => {
+            let seed = world.resource_mut::<SimRng>().0.random::<u64>();
+            if let Some(generate) = scene.file.generate.as_mut() {
+                generate.seed = seed;
+            }
+        }
+        SceneRequest::Load(path) => match SceneFile::load(&path) {
+            Ok(file) => {
+                scene = CurrentScene {
+                    file,
+                    origin: path.display().to_string(),
+                }
+            }
+            Err(error) => {
+                world.resource_mut::<SceneStatus>().0 = Some(error.to_string());
+                return;
+            }
+        },
+    }
+    match scene.file.build(&scene.origin) {
+        Ok(setup) => {
+            let arena = setup.params.arena_size;
+            setup.apply(world);
+            resize_window_for(world, arena);
+            world.insert_resource(scene);
+            world.resource_mut::<SceneStatus>().0 = None;
+        }
+        Err(error) => world.resource_mut::<SceneStatus>().0 = Some(error.to_string()),
+    }
+}
+
+/// Asks for a window that shows `arena` beside the panel. Until it arrives the arena keeps
+/// the scene's size; then it follows the window.
+fn resize_window_for(world: &mut World, arena: DVec2) {
+    let panel = world.resource::<PlayArea>().panel_width;
+    let wanted = (arena.as_vec2() + Vec2::new(panel, 0.0)).clamp(MIN_WINDOW, MAX_WINDOW);
+    let mut windows = world.query_filtered::<&mut Window, With<PrimaryWindow>>();
+    if let Ok(mut window) = windows.single_mut(world)
+        && window.size() != wanted
+    {
+        window.resolution.set(wanted.x, wanted.y);
     }
 }
 

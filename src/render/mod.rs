@@ -1,9 +1,13 @@
-//! Drawing the simulation: a 2D camera, one sprite per ball and the arena's walls following the
-//! window. Reads simulation state and sets only the arena size; runs in `Update`/`PostUpdate`
-//! of the windowed app, never in the headless one.
+//! Drawing the simulation: a 2D camera, one sprite per ball, overlays and effects. Reads
+//! simulation state; writes only the arena size (the arena is the window's play area). Runs
+//! in the windowed app's `Update`/`PostUpdate`, never in the headless one.
 //!
 //! Every ball's sprite shares one anti-aliased circle texture made at start-up, so all balls
-//! draw as one batch and stay round at any size.
+//! draw as one batch and stay round at any size. Sprites are placed between the last two
+//! fixed steps by `Time<Fixed>::overstep_fraction`, so motion is smooth at any display rate.
+
+pub mod effects;
+pub mod overlays;
 
 use bevy::asset::RenderAssetUsages;
 use bevy::image::{Image, ImageSampler};
@@ -12,32 +16,94 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy::window::PrimaryWindow;
 
-use crate::sim::{Ball, BallId, Position, Radius, SimParams};
+use crate::sim::{Ball, BallId, Position, PreviousPosition, Radius, SimParams, Velocity};
 
 /// Side of the shared circle texture, texels: large enough that a ball 256 px wide is crisp.
 const CIRCLE_TEXTURE_SIZE: u32 = 256;
-/// Background behind the arena.
-const BACKGROUND: Color = Color::srgb(0.06, 0.07, 0.09);
+/// Background outside the arena.
+const BACKGROUND: Color = Color::srgb(0.03, 0.035, 0.045);
+/// The arena's floor, drawn behind the balls.
+const ARENA_FLOOR: Color = Color::srgb(0.07, 0.08, 0.1);
+/// Speed shown as the hottest colour in [`ColourMode::BySpeed`], pixels per second.
+const HOT_SPEED: f64 = 600.0;
+/// Radius range spanned by the colours of [`ColourMode::BySize`], pixels.
+const SIZE_COLOUR_RANGE: (f64, f64) = (5.0, 50.0);
 
 pub fn plugin(app: &mut App) {
     app.insert_resource(ClearColor(BACKGROUND))
+        .init_resource::<ViewSettings>()
+        .init_resource::<PlayArea>()
         // The texture must exist before any scene's balls are spawned (in `Startup`).
         .add_systems(PreStartup, make_circle_texture)
-        .add_systems(Startup, spawn_camera)
+        .add_systems(Startup, (spawn_camera, spawn_arena_floor))
         .add_observer(give_ball_a_sprite)
         .add_systems(Update, fit_arena_to_window)
         .add_systems(
             PostUpdate,
-            place_ball_sprites.before(TransformSystems::Propagate),
-        );
+            (place_ball_sprites, colour_balls, place_camera_and_floor)
+                .before(TransformSystems::Propagate),
+        )
+        .add_plugins((overlays::plugin, effects::plugin));
+}
+
+/// How balls are coloured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ColourMode {
+    /// A distinct colour per ball.
+    #[default]
+    ByBall,
+    /// Small balls cool, large balls warm.
+    BySize,
+    /// Slow balls cool, fast balls hot.
+    BySpeed,
+}
+
+/// What the view shows; the panel tunes it.
+#[derive(Resource, Clone, Debug, PartialEq)]
+pub struct ViewSettings {
+    pub colour_mode: ColourMode,
+    pub show_aabbs: bool,
+    pub show_contacts: bool,
+    pub show_velocities: bool,
+    pub show_bursts: bool,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings {
+            colour_mode: ColourMode::ByBall,
+            show_aabbs: false,
+            show_contacts: false,
+            show_velocities: false,
+            show_bursts: true,
+        }
+    }
+}
+
+/// Width of the window strip the side panel covers, logical pixels; the arena fills the rest.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlayArea {
+    pub panel_width: f32,
 }
 
 /// The texture every ball sprite draws: a white disc with a one-texel soft edge.
 #[derive(Resource)]
 struct CircleTexture(Handle<Image>);
 
+#[derive(Component)]
+struct ArenaFloor;
+
 fn spawn_camera(mut commands: Commands) {
     commands.spawn((Name::new("Camera"), Camera2d));
+}
+
+fn spawn_arena_floor(mut commands: Commands) {
+    commands.spawn((
+        Name::new("Arena floor"),
+        ArenaFloor,
+        Sprite::from_color(ARENA_FLOOR, Vec2::ONE),
+        Transform::from_xyz(0.0, 0.0, -1.0),
+    ));
 }
 
 fn make_circle_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
@@ -72,40 +138,136 @@ pub fn ball_colour(id: BallId) -> Color {
     Color::hsl(hue, 0.65, 0.6)
 }
 
+/// A colour from cool (0) to hot (1).
+pub fn heat_colour(heat: f64) -> Color {
+    let heat = heat.clamp(0.0, 1.0) as f32;
+    Color::hsl(240.0 * (1.0 - heat), 0.75, 0.55)
+}
+
+fn colour_of(mode: ColourMode, id: BallId, radius: f64, velocity: DVec2) -> Color {
+    match mode {
+        ColourMode::ByBall => ball_colour(id),
+        ColourMode::BySize => {
+            let (small, large) = SIZE_COLOUR_RANGE;
+            heat_colour((radius - small) / (large - small))
+        }
+        ColourMode::BySpeed => heat_colour(velocity.length() / HOT_SPEED),
+    }
+}
+
 fn give_ball_a_sprite(
     added: On<Add, Ball>,
-    balls: Query<(&BallId, &Radius)>,
+    balls: Query<(&BallId, &Radius, &Position, &Velocity)>,
     texture: Option<Res<CircleTexture>>,
+    view: Res<ViewSettings>,
     mut commands: Commands,
 ) {
-    let (Ok((id, radius)), Some(texture)) = (balls.get(added.entity), texture) else {
+    let (Ok((id, radius, position, velocity)), Some(texture)) = (balls.get(added.entity), texture)
+    else {
         return;
     };
     commands.entity(added.entity).insert((
         Sprite {
             image: texture.0.clone(),
-            color: ball_colour(*id),
+            color: colour_of(view.colour_mode, *id, radius.0, velocity.0),
             custom_size: Some(Vec2::splat(2.0 * radius.0 as f32)),
             ..default()
         },
-        Transform::default(),
+        Transform::from_translation(position.as_vec2().extend(0.0)),
     ));
 }
 
-fn place_ball_sprites(mut balls: Query<(&Position, &mut Transform), With<Ball>>) {
-    for (position, mut transform) in &mut balls {
-        transform.translation = position.as_vec2().extend(0.0);
+/// How far between the previous and the latest fixed step to draw: 1 (the latest state)
+/// while paused, since no step is under way.
+pub fn interpolation_fraction(fixed: &Time<Fixed>, params: &SimParams) -> f64 {
+    if params.paused {
+        1.0
+    } else {
+        fixed.overstep_fraction_f64().clamp(0.0, 1.0)
     }
 }
 
-/// The arena is the window's play area: its walls follow a resize (balls left outside are
-/// brought back in by the movement stage's wall containment).
+/// Where to draw a ball this frame.
+pub fn drawn_position(previous: &PreviousPosition, position: &Position, fraction: f64) -> Vec2 {
+    previous.0.lerp(position.0, fraction).as_vec2()
+}
+
+fn place_ball_sprites(
+    fixed: Res<Time<Fixed>>,
+    params: Res<SimParams>,
+    mut balls: Query<(&PreviousPosition, &Position, &mut Transform), With<Ball>>,
+) {
+    let fraction = interpolation_fraction(&fixed, &params);
+    balls
+        .par_iter_mut()
+        .for_each(|(previous, position, mut transform)| {
+            transform.translation = drawn_position(previous, position, fraction).extend(0.0);
+        });
+}
+
+fn colour_balls(
+    view: Res<ViewSettings>,
+    mut balls: Query<(&BallId, &Radius, &Velocity, &mut Sprite), With<Ball>>,
+) {
+    // Colours by ball and by size change only with the mode; by speed, every frame.
+    if !view.is_changed() && view.colour_mode != ColourMode::BySpeed {
+        return;
+    }
+    balls
+        .par_iter_mut()
+        .for_each(|(id, radius, velocity, mut sprite)| {
+            sprite.color = colour_of(view.colour_mode, *id, radius.0, velocity.0);
+        });
+}
+
+/// The arena is the window's play area (right of the panel): its walls follow a resize, and
+/// balls left outside after a shrink are brought back in by the movement stage's walls.
 fn fit_arena_to_window(
     window: Single<&Window, With<PrimaryWindow>>,
+    play_area: Res<PlayArea>,
     mut params: ResMut<SimParams>,
 ) {
-    let size = DVec2::new(window.width() as f64, window.height() as f64);
+    let width = (window.width() - play_area.panel_width).max(0.0);
+    let size = DVec2::new(width as f64, window.height() as f64);
     if params.arena_size != size {
         params.arena_size = size;
+    }
+}
+
+/// Shifts the camera so the arena (centred on the origin) sits right of the panel.
+fn place_camera_and_floor(
+    play_area: Res<PlayArea>,
+    params: Res<SimParams>,
+    mut camera: Single<&mut Transform, (With<Camera2d>, Without<ArenaFloor>)>,
+    mut floor: Single<(&mut Transform, &mut Sprite), With<ArenaFloor>>,
+) {
+    camera.translation.x = -play_area.panel_width / 2.0;
+    floor.0.translation = Vec3::new(0.0, 0.0, -1.0);
+    floor.1.custom_size = Some(params.arena_size.as_vec2());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn drawn_position_interpolates_between_steps() {
+        let previous = PreviousPosition(DVec2::new(0.0, 0.0));
+        let position = Position(DVec2::new(10.0, -4.0));
+        assert_eq!(
+            drawn_position(&previous, &position, 0.25),
+            Vec2::new(2.5, -1.0)
+        );
+        assert_eq!(
+            drawn_position(&previous, &position, 1.0),
+            Vec2::new(10.0, -4.0)
+        );
+    }
+
+    #[test]
+    fn heat_runs_from_blue_to_red_and_clamps() {
+        assert_eq!(heat_colour(-1.0), heat_colour(0.0));
+        assert_eq!(heat_colour(7.0), heat_colour(1.0));
+        assert_ne!(heat_colour(0.0), heat_colour(1.0));
     }
 }

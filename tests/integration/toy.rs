@@ -2,10 +2,10 @@
 //! ball-count slider, and the aiming guide's prediction against the simulation's outcome.
 
 use ballpit::prelude::*;
-use ballpit::sim::{PendingSteps, SpawnSettings};
 use ballpit::sim::aim::{AimTarget, predict_first_hit};
 use ballpit::sim::collision::narrow_phase::Circle;
 use ballpit::sim::spawn::set_ball_count;
+use ballpit::sim::{PendingSteps, SpawnSettings};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 

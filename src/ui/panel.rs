@@ -1,0 +1,410 @@
+//! The egui side panel: every tunable live (sliders, buttons, scene picker, overlays) and
+//! readouts (FPS, balls, collisions per second, energy, momentum, an energy plot). Edits go to
+//! copies that are clamped to their limits and written back only when they changed. Runs in
+//! `EguiPrimaryContextPass`; [`Readouts`] are gathered in `Update`.
+
+use std::collections::VecDeque;
+use std::ops::RangeInclusive;
+use std::path::{Path, PathBuf};
+
+use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
+use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_egui::egui::{self, Color32, RichText, Slider};
+use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
+use egui_plot::{Line, Plot, PlotPoints};
+
+use super::PANEL_WIDTH;
+use crate::play::{CurrentScene, SceneRequest, SceneStatus};
+use crate::render::{ColourMode, PlayArea, ViewSettings};
+use crate::sim::spawn::set_ball_count;
+use crate::sim::stats::kinetic_energy;
+use crate::sim::{
+    Ball, MassModel, PendingSteps, Radius, SimParams, SimStats, SpawnSettings, Velocity,
+};
+
+/// Where the scene picker looks for scene files, relative to the working directory.
+pub const SCENE_FOLDER: &str = "assets/scenes";
+/// The ball-count slider's range.
+pub const BALL_COUNT_RANGE: RangeInclusive<usize> = 0..=100_000;
+/// The radius sliders' range, pixels.
+pub const RADIUS_SLIDER: RangeInclusive<f64> = 0.5..=200.0;
+/// The speed sliders' range, pixels per second.
+pub const SPEED_SLIDER: RangeInclusive<f64> = 0.0..=3_000.0;
+/// The gravity sliders' range (each component), pixels per second squared.
+pub const GRAVITY_SLIDER: RangeInclusive<f64> = -3_000.0..=3_000.0;
+/// The time-scale slider's range.
+pub const TIME_SCALE_SLIDER: RangeInclusive<f64> = 0.0..=10.0;
+/// The fixed-step rate slider's range, steps per second.
+pub const STEP_RATE_SLIDER: RangeInclusive<f64> = 10.0..=480.0;
+/// The damping slider's range, per second.
+pub const DAMPING_SLIDER: RangeInclusive<f64> = 0.0..=10.0;
+/// Simulated seconds of kinetic energy the plot shows.
+const PLOT_SECONDS: f64 = 10.0;
+/// Simulated seconds between plot samples.
+const PLOT_SAMPLE_SECONDS: f64 = 0.05;
+/// Simulated seconds over which collisions per second are counted.
+const RATE_WINDOW_SECONDS: f64 = 1.0;
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<PanelVisible>()
+        .init_resource::<Readouts>()
+        .insert_resource(SceneList::read(Path::new(SCENE_FOLDER)))
+        .add_systems(Update, update_readouts)
+        .add_systems(EguiPrimaryContextPass, draw_panel);
+}
+
+/// Whether the panel is shown (H toggles it).
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PanelVisible(pub bool);
+
+impl Default for PanelVisible {
+    fn default() -> Self {
+        PanelVisible(true)
+    }
+}
+
+/// The scene files the picker offers.
+#[derive(Resource, Debug, Clone, Default, PartialEq)]
+pub struct SceneList(pub Vec<PathBuf>);
+
+impl SceneList {
+    /// The `.ron` files in `folder`, sorted; none if it cannot be read.
+    pub fn read(folder: &Path) -> SceneList {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+            .map(|entries| {
+                entries
+                    .filter_map(|entry| entry.ok().map(|e| e.path()))
+                    .filter(|path| path.extension().is_some_and(|ext| ext == "ron"))
+                    .collect()
+            })
+            .unwrap_or_default();
+        files.sort();
+        SceneList(files)
+    }
+}
+
+/// Figures the panel shows, gathered every frame.
+#[derive(Resource, Debug, Default)]
+pub struct Readouts {
+    pub balls: usize,
+    pub kinetic_energy: f64,
+    pub momentum: DVec2,
+    pub collisions_per_second: f64,
+    /// (simulated seconds, kinetic energy) over the last [`PLOT_SECONDS`].
+    pub energy_history: VecDeque<[f64; 2]>,
+    /// (simulated seconds, collisions so far) over the last [`RATE_WINDOW_SECONDS`].
+    collision_samples: VecDeque<(f64, u64)>,
+}
+
+fn update_readouts(
+    params: Res<SimParams>,
+    stats: Res<SimStats>,
+    balls: Query<(&Velocity, &Radius), With<Ball>>,
+    mut readouts: ResMut<Readouts>,
+) {
+    let mass_model = params.mass_model;
+    let (mut energy, mut momentum) = (0.0, DVec2::ZERO);
+    for (velocity, radius) in &balls {
+        let mass = mass_model.mass(radius.0);
+        energy += kinetic_energy(mass, velocity.0);
+        momentum += velocity.0 * mass;
+    }
+    let now = stats.sim_time;
+    let readouts = &mut *readouts;
+    readouts.balls = balls.iter().len();
+    readouts.kinetic_energy = energy;
+    readouts.momentum = momentum;
+    // A reset rewinds simulated time: start the history afresh.
+    if readouts
+        .collision_samples
+        .back()
+        .is_some_and(|&(t, _)| t > now)
+    {
+        readouts.collision_samples.clear();
+        readouts.energy_history.clear();
+    }
+    if readouts
+        .collision_samples
+        .back()
+        .is_none_or(|&(t, _)| t < now)
+    {
+        readouts
+            .collision_samples
+            .push_back((now, stats.ball_collisions));
+    }
+    while readouts.collision_samples.len() > 2
+        && readouts.collision_samples[1].0 <= now - RATE_WINDOW_SECONDS
+    {
+        readouts.collision_samples.pop_front();
+    }
+    readouts.collisions_per_second = match (
+        readouts.collision_samples.front(),
+        readouts.collision_samples.back(),
+    ) {
+        (Some(&(t0, c0)), Some(&(t1, c1))) if t1 > t0 => (c1 - c0) as f64 / (t1 - t0),
+        _ => 0.0,
+    };
+    if readouts
+        .energy_history
+        .back()
+        .is_none_or(|&[t, _]| now - t >= PLOT_SAMPLE_SECONDS)
+    {
+        readouts.energy_history.push_back([now, energy]);
+    }
+    while readouts
+        .energy_history
+        .front()
+        .is_some_and(|&[t, _]| t < now - PLOT_SECONDS)
+    {
+        readouts.energy_history.pop_front();
+    }
+}
+
+/// Everything the panel edits.
+#[derive(SystemParam)]
+struct Tunables<'w> {
+    params: ResMut<'w, SimParams>,
+    spawn: ResMut<'w, SpawnSettings>,
+    view: ResMut<'w, ViewSettings>,
+    fixed: ResMut<'w, Time<Fixed>>,
+    pending: ResMut<'w, PendingSteps>,
+}
+
+/// Everything the panel only shows.
+#[derive(SystemParam)]
+struct Shown<'w> {
+    readouts: Res<'w, Readouts>,
+    diagnostics: Res<'w, DiagnosticsStore>,
+    scenes: Res<'w, SceneList>,
+    current: Res<'w, CurrentScene>,
+    status: Res<'w, SceneStatus>,
+}
+
+fn draw_panel(
+    mut contexts: EguiContexts,
+    visible: Res<PanelVisible>,
+    mut play_area: ResMut<PlayArea>,
+    mut tunables: Tunables,
+    shown: Shown,
+    mut requests: MessageWriter<SceneRequest>,
+    mut commands: Commands,
+) -> Result {
+    let width = if visible.0 { PANEL_WIDTH } else { 0.0 };
+    if play_area.panel_width != width {
+        play_area.panel_width = width;
+    }
+    if !visible.0 {
+        return Ok(());
+    }
+    let ctx = contexts.ctx_mut()?;
+    let mut root = egui::Ui::new(
+        ctx.clone(),
+        "ballpit-root".into(),
+        egui::UiBuilder::new()
+            .layer_id(egui::LayerId::background())
+            .max_rect(ctx.viewport_rect()),
+    );
+    egui::Panel::left("ballpit-panel")
+        .exact_size(PANEL_WIDTH)
+        .resizable(false)
+        .show(&mut root, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                ui.heading("ballpit");
+                ui.label(RichText::new("Space pause · N step · R reset · H hide").small());
+                controls(ui, &mut tunables, &shown, &mut requests);
+                balls(ui, &mut tunables.spawn, &shown.readouts, &mut commands);
+                physics(ui, &mut tunables);
+                view(ui, &mut tunables.view);
+                readouts(ui, &shown);
+            });
+        });
+    Ok(())
+}
+
+fn controls(
+    ui: &mut egui::Ui,
+    tunables: &mut Tunables,
+    shown: &Shown,
+    requests: &mut MessageWriter<SceneRequest>,
+) {
+    ui.horizontal(|ui| {
+        let label = if tunables.params.paused {
+            "▶ Resume"
+        } else {
+            "⏸ Pause"
+        };
+        if ui.button(label).clicked() {
+            tunables.params.paused = !tunables.params.paused;
+        }
+        if ui.button("Step").clicked() {
+            tunables.params.paused = true;
+            tunables.pending.0 += 1;
+        }
+        if ui.button("Reset").clicked() {
+            requests.write(SceneRequest::Reset);
+        }
+        if ui.button("New seed").clicked() {
+            requests.write(SceneRequest::NewSeed);
+        }
+    });
+    let current_name = Path::new(&shown.current.origin)
+        .file_name()
+        .map_or(shown.current.origin.clone(), |name| {
+            name.to_string_lossy().into_owned()
+        });
+    egui::ComboBox::from_label("Scene")
+        .selected_text(current_name)
+        .show_ui(ui, |ui| {
+            for path in &shown.scenes.0 {
+                let name = path.file_name().unwrap_or_default().to_string_lossy();
+                if ui.selectable_label(false, name).clicked() {
+                    requests.write(SceneRequest::Load(path.clone()));
+                }
+            }
+            if shown.scenes.0.is_empty() {
+                ui.label(format!("no scenes in ./{SCENE_FOLDER}"));
+            }
+        });
+    if let Some(error) = &shown.status.0 {
+        ui.colored_label(Color32::from_rgb(255, 120, 110), error);
+    }
+}
+
+fn balls(
+    ui: &mut egui::Ui,
+    spawn: &mut SpawnSettings,
+    readouts: &Readouts,
+    commands: &mut Commands,
+) {
+    egui::CollapsingHeader::new("Balls")
+        .default_open(true)
+        .show(ui, |ui| {
+            let mut count = readouts.balls;
+            let response = ui.add(
+                Slider::new(&mut count, BALL_COUNT_RANGE)
+                    .logarithmic(true)
+                    .text("count"),
+            );
+            if response.changed() {
+                commands.queue(move |world: &mut World| {
+                    set_ball_count(world, count);
+                });
+            }
+            let mut edited = *spawn;
+            ui.add(
+                Slider::new(&mut edited.radius.0, RADIUS_SLIDER)
+                    .logarithmic(true)
+                    .text("radius min"),
+            );
+            ui.add(
+                Slider::new(&mut edited.radius.1, RADIUS_SLIDER)
+                    .logarithmic(true)
+                    .text("radius max"),
+            );
+            ui.add(Slider::new(&mut edited.speed.0, SPEED_SLIDER).text("speed min"));
+            ui.add(Slider::new(&mut edited.speed.1, SPEED_SLIDER).text("speed max"));
+            edited.clamp_to_limits();
+            if edited != *spawn {
+                *spawn = edited;
+            }
+        });
+}
+
+fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
+    egui::CollapsingHeader::new("Physics")
+        .default_open(true)
+        .show(ui, |ui| {
+            let mut edited = tunables.params.clone();
+            ui.add(Slider::new(&mut edited.gravity.x, GRAVITY_SLIDER).text("gravity x"));
+            ui.add(Slider::new(&mut edited.gravity.y, GRAVITY_SLIDER).text("gravity y"));
+            ui.add(Slider::new(&mut edited.restitution, 0.0..=1.0).text("restitution"));
+            ui.horizontal(|ui| {
+                ui.label("mass");
+                for (model, name) in MassModel::ALL.into_iter().zip(["radius", "area", "unit"]) {
+                    ui.radio_value(&mut edited.mass_model, model, name);
+                }
+            });
+            ui.add(
+                Slider::new(&mut edited.time_scale, TIME_SCALE_SLIDER)
+                    .logarithmic(true)
+                    .smallest_positive(0.01)
+                    .text("time scale"),
+            );
+            ui.add(Slider::new(&mut edited.linear_damping, DAMPING_SLIDER).text("damping /s"));
+            edited.clamp_to_limits();
+            if edited != *tunables.params {
+                *tunables.params = edited;
+            }
+            let mut rate = 1.0 / tunables.fixed.timestep().as_secs_f64();
+            if ui
+                .add(Slider::new(&mut rate, STEP_RATE_SLIDER).text("steps /s"))
+                .changed()
+            {
+                tunables.fixed.set_timestep_hz(
+                    rate.clamp(*STEP_RATE_SLIDER.start(), *STEP_RATE_SLIDER.end()),
+                );
+            }
+        });
+}
+
+fn view(ui: &mut egui::Ui, view: &mut ViewSettings) {
+    egui::CollapsingHeader::new("View")
+        .default_open(true)
+        .show(ui, |ui| {
+            let mut edited = view.clone();
+            ui.horizontal(|ui| {
+                ui.label("colour");
+                ui.radio_value(&mut edited.colour_mode, ColourMode::ByBall, "ball");
+                ui.radio_value(&mut edited.colour_mode, ColourMode::BySize, "size");
+                ui.radio_value(&mut edited.colour_mode, ColourMode::BySpeed, "speed");
+            });
+            ui.checkbox(&mut edited.show_aabbs, "AABBs");
+            ui.checkbox(&mut edited.show_contacts, "contact points");
+            ui.checkbox(&mut edited.show_velocities, "velocity arrows");
+            ui.checkbox(&mut edited.show_bursts, "collision bursts");
+            if edited != *view {
+                *view = edited;
+            }
+        });
+}
+
+fn readouts(ui: &mut egui::Ui, shown: &Shown) {
+    egui::CollapsingHeader::new("Readouts")
+        .default_open(true)
+        .show(ui, |ui| {
+            let fps = shown
+                .diagnostics
+                .get(&FrameTimeDiagnosticsPlugin::FPS)
+                .and_then(|fps| fps.smoothed())
+                .unwrap_or(0.0);
+            let r = &shown.readouts;
+            egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
+                for (name, value) in [
+                    ("FPS", format!("{fps:.0}")),
+                    ("balls", format!("{}", r.balls)),
+                    ("collisions /s", format!("{:.0}", r.collisions_per_second)),
+                    ("kinetic energy", format!("{:.4e}", r.kinetic_energy)),
+                    (
+                        "momentum",
+                        format!("({:.3e}, {:.3e})", r.momentum.x, r.momentum.y),
+                    ),
+                ] {
+                    ui.label(name);
+                    ui.monospace(value);
+                    ui.end_row();
+                }
+            });
+            let points: PlotPoints = r.energy_history.iter().copied().collect();
+            Plot::new("energy-plot")
+                .height(110.0)
+                .include_y(0.0)
+                .allow_drag(false)
+                .allow_zoom(false)
+                .allow_scroll(false)
+                .allow_boxed_zoom(false)
+                .x_axis_label("simulated s")
+                .show(ui, |plot| plot.line(Line::new("kinetic energy", points)));
+        });
+}
