@@ -27,7 +27,8 @@ fn windowless_game(scene: &str) -> App {
                 })),
                 ..default()
             })
-            .disable::<WinitPlugin>(),
+            .disable::<WinitPlugin>()
+            .disable::<bevy::log::LogPlugin>(),
     )
     .add_plugins(GamePlugin)
     .insert_resource(CurrentScene {
@@ -71,4 +72,43 @@ fn a_bad_scene_request_keeps_the_current_scene_and_reports() {
         2
     );
     assert_eq!(world.resource::<CurrentScene>().origin, "head_on.ron");
+}
+
+#[test]
+fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
+    let mut app = windowless_game("gas.ron");
+    let window = app
+        .world_mut()
+        .spawn((Window::default(), bevy::window::PrimaryWindow))
+        .id();
+    // Loading the scene sizes the window to fit it; then the player resizes it.
+    app.update();
+    app.world_mut()
+        .get_mut::<Window>(window)
+        .unwrap()
+        .resolution
+        .set(1400.0, 900.0);
+    for _ in 0..3 {
+        app.update();
+    }
+    let panel = ballpit::ui::PANEL_WIDTH as f64;
+    let arena = app.world().resource::<SimParams>().arena_size;
+    assert_eq!(arena, bevy::math::DVec2::new(1400.0 - panel, 900.0));
+    app.world_mut()
+        .get_mut::<Window>(window)
+        .unwrap()
+        .resolution
+        .set(700.0, 500.0);
+    for _ in 0..3 {
+        app.update();
+    }
+    let half = app.world().resource::<SimParams>().half_extents();
+    assert_eq!(half, bevy::math::DVec2::new((700.0 - panel) / 2.0, 250.0));
+    for ball in states(&mut app) {
+        let reach = ball.position.abs() + bevy::math::DVec2::splat(ball.radius);
+        assert!(
+            reach.x <= half.x + 1e-9 && reach.y <= half.y + 1e-9,
+            "{ball:?}"
+        );
+    }
 }
