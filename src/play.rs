@@ -50,6 +50,10 @@ pub enum SceneRequest {
     Load(PathBuf),
 }
 
+/// A scene was (re)loaded: anything that keeps history of the old one starts afresh.
+#[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneLoaded;
+
 /// The last scene error, shown in the panel until a scene loads.
 #[derive(Resource, Clone, Debug, Default, PartialEq)]
 pub struct SceneStatus(pub Option<String>);
@@ -89,6 +93,7 @@ impl Plugin for GamePlugin {
         app.add_plugins((SimPlugin, render::plugin, ui::plugin))
             .insert_resource(Time::<Fixed>::from_hz(DEFAULT_STEP_RATE))
             .add_message::<SceneRequest>()
+            .add_message::<SceneLoaded>()
             .init_resource::<SceneStatus>()
             .add_systems(Startup, |mut requests: MessageWriter<SceneRequest>| {
                 requests.write(SceneRequest::Reset);
@@ -144,6 +149,7 @@ fn apply_scene_request(world: &mut World, request: SceneRequest) {
             resize_window_for(world, arena);
             world.insert_resource(scene);
             world.resource_mut::<SceneStatus>().0 = None;
+            world.write_message(SceneLoaded);
         }
         Err(error) => world.resource_mut::<SceneStatus>().0 = Some(error.to_string()),
     }

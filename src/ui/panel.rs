@@ -16,7 +16,7 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
 use egui_plot::{Line, Plot, PlotPoints};
 
 use super::PANEL_WIDTH;
-use crate::play::{CurrentScene, SceneRequest, SceneStatus};
+use crate::play::{CurrentScene, SceneLoaded, SceneRequest, SceneStatus};
 use crate::render::{ColourMode, PlayArea, ViewSettings};
 use crate::sim::spawn::set_ball_count;
 use crate::sim::stats::kinetic_energy;
@@ -102,6 +102,7 @@ fn update_readouts(
     params: Res<SimParams>,
     stats: Res<SimStats>,
     balls: Query<(&Velocity, &Radius), With<Ball>>,
+    mut loaded: MessageReader<SceneLoaded>,
     mut readouts: ResMut<Readouts>,
 ) {
     let mass_model = params.mass_model;
@@ -116,12 +117,7 @@ fn update_readouts(
     readouts.balls = balls.iter().len();
     readouts.kinetic_energy = energy;
     readouts.momentum = momentum;
-    // A reset rewinds simulated time: start the history afresh.
-    if readouts
-        .collision_samples
-        .back()
-        .is_some_and(|&(t, _)| t > now)
-    {
+    if loaded.read().count() > 0 {
         readouts.collision_samples.clear();
         readouts.energy_history.clear();
     }
