@@ -35,6 +35,8 @@ pub fn headless_app(dt: f64) -> App {
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {
     pub balls: usize,
+    /// Arena width and height, pixels.
+    pub arena: [f64; 2],
     pub steps: u64,
     pub dt_s: f64,
     pub sim_time_s: f64,
@@ -90,6 +92,7 @@ pub fn run_scene(setup: &SceneSetup, steps: u64, dt: f64) -> (App, RunReport) {
     let arena_size = app.world().resource::<SimParams>().arena_size;
     let report = RunReport {
         balls: end.ball_count,
+        arena: arena_size.to_array(),
         steps: stats.steps,
         dt_s: dt,
         sim_time_s: stats.sim_time,
