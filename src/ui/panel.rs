@@ -180,7 +180,7 @@ struct Shown<'w> {
 
 fn draw_panel(
     mut contexts: EguiContexts,
-    visible: Res<PanelVisible>,
+    mut visible: ResMut<PanelVisible>,
     mut play_area: ResMut<PlayArea>,
     mut tunables: Tunables,
     shown: Shown,
@@ -191,10 +191,17 @@ fn draw_panel(
     if play_area.panel_width != width {
         play_area.panel_width = width;
     }
+    let ctx = contexts.ctx_mut()?;
     if !visible.0 {
+        egui::Area::new("ballpit-reopen".into())
+            .fixed_pos([6.0, 6.0])
+            .show(ctx, |ui| {
+                if ui.button("☰ Panel (H)").clicked() {
+                    visible.0 = true;
+                }
+            });
         return Ok(());
     }
-    let ctx = contexts.ctx_mut()?;
     let mut root = egui::Ui::new(
         ctx.clone(),
         "ballpit-root".into(),
@@ -207,7 +214,12 @@ fn draw_panel(
         .resizable(false)
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                ui.heading("ballpit");
+                ui.horizontal(|ui| {
+                    ui.heading("ballpit");
+                    if ui.small_button("Hide (H)").clicked() {
+                        visible.0 = false;
+                    }
+                });
                 ui.label(RichText::new("Space pause · N step · R reset · H hide").small());
                 controls(ui, &mut tunables, &shown, &mut requests);
                 balls(ui, &mut tunables.spawn, &shown.readouts, &mut commands);
