@@ -8,15 +8,21 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::headless::{DEFAULT_DT, StateDump, run_scene};
+use crate::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
+use crate::headless::{DEFAULT_DT, StateDump, run_scene_with_threads};
 use crate::play::{CurrentScene, PlayOptions, play};
-use crate::sim::SceneFile;
+use crate::sim::params::MAX_BALLS;
+use crate::sim::{BroadPhase, SceneFile};
 
 /// The scene played when no `--scene` is given, built in so it works from any directory.
 const DEMO_SCENE: &str = include_str!("../assets/scenes/demo.ron");
 
 /// Largest step count accepted by `run`.
 const MAX_STEPS: u64 = 100_000_000;
+/// Most worker threads accepted.
+const MAX_THREADS: u64 = 256;
+/// Largest ball count the bench accepts.
+const MAX_BENCH_BALLS: u64 = MAX_BALLS as u64;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -50,6 +56,55 @@ pub struct PlayArgs {
 pub enum Command {
     /// Run a scene headless (no window, no GPU) for a number of fixed steps and report.
     Run(RunArgs),
+    /// Time the standard gas at several sizes, on one core and on all, against all pairs.
+    Bench(BenchArgs),
+    /// One bench case in this process, printed as JSON (what `bench` runs in its children).
+    #[command(hide = true)]
+    BenchOne(BenchOneArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Ball counts, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000, 10_000, 100_000],
+          value_parser = clap::value_parser!(u64).range(1..=MAX_BENCH_BALLS))]
+    pub sizes: Vec<u64>,
+    /// Timed steps per case (after a short warm-up).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub steps: u64,
+    /// Run the all-pairs reference for sizes up to this (it is O(N^2)).
+    #[arg(long, default_value_t = 10_000)]
+    pub all_pairs_max: u64,
+    /// Print the rows as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct BenchOneArgs {
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_BENCH_BALLS))]
+    pub balls: u64,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub steps: u64,
+    #[arg(long, value_enum, default_value_t = BroadPhaseArg::Grid)]
+    pub broad_phase: BroadPhaseArg,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
+    pub threads: u64,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum BroadPhaseArg {
+    Grid,
+    AllPairs,
+}
+
+impl From<BroadPhaseArg> for BroadPhase {
+    fn from(arg: BroadPhaseArg) -> Self {
+        match arg {
+            BroadPhaseArg::Grid => BroadPhase::Grid,
+            BroadPhaseArg::AllPairs => BroadPhase::AllPairs,
+        }
+    }
 }
 
 #[derive(Debug, clap::Args)]
@@ -75,6 +130,9 @@ pub struct RunArgs {
     /// Write the final state of every ball to this JSON file.
     #[arg(long, value_name = "OUT.json")]
     pub dump: Option<PathBuf>,
+    /// Worker threads for the parallel parts of the stages (default: as many as cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
+    pub threads: Option<u64>,
 }
 
 fn parse_step_seconds(text: &str) -> Result<f64, String> {
@@ -91,6 +149,8 @@ impl Cli {
     pub fn run(self) -> ExitCode {
         let outcome = match self.command {
             Some(Command::Run(args)) => run_headless(args),
+            Some(Command::Bench(args)) => run_bench(args),
+            Some(Command::BenchOne(args)) => run_bench_one(args),
             None => run_window(self.play),
         };
         match outcome {
@@ -137,7 +197,8 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
         generate.seed = args.seed.unwrap_or(generate.seed);
     }
     let setup = scene.build(&origin)?;
-    let (mut app, report) = run_scene(&setup, args.steps, args.dt);
+    let threads = args.threads.map(|n| n as usize);
+    let (mut app, report) = run_scene_with_threads(&setup, args.steps, args.dt, threads);
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {
@@ -149,5 +210,53 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
         std::fs::write(&path, text)
             .map_err(|e| format!("{}: cannot write the dump: {e}", path.display()))?;
     }
+    Ok(())
+}
+
+fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
+    let mut rows = Vec::new();
+    for &balls in &args.sizes {
+        let balls = balls as usize;
+        let grid = BenchCase {
+            balls,
+            steps: args.steps,
+            broad_phase: BroadPhase::Grid,
+        };
+        let all_pairs = (balls as u64 <= args.all_pairs_max).then_some(BenchCase {
+            steps: (args.steps / 10).max(5),
+            broad_phase: BroadPhase::AllPairs,
+            ..grid
+        });
+        let row = BenchRow {
+            balls,
+            one_core: run_case_in_child(grid, true)?,
+            all_cores: run_case_in_child(grid, false)?,
+            all_pairs: all_pairs
+                .map(|case| run_case_in_child(case, true))
+                .transpose()?,
+        };
+        if !args.json {
+            eprintln!("measured {balls} balls");
+        }
+        rows.push(row);
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&rows)?);
+    } else {
+        print!("{}", format_table(&rows));
+    }
+    Ok(())
+}
+
+fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
+    let case = BenchCase {
+        balls: args.balls as usize,
+        steps: args.steps,
+        broad_phase: args.broad_phase.into(),
+    };
+    println!(
+        "{}",
+        serde_json::to_string(&run_case(case, args.threads as usize)?)?
+    );
     Ok(())
 }

@@ -4,6 +4,7 @@
 
 use std::time::{Duration, Instant};
 
+use bevy::app::{TaskPoolOptions, TaskPoolPlugin};
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
@@ -19,10 +20,25 @@ pub const DEFAULT_DT: f64 = 1.0 / 60.0;
 /// An app with only the simulation, in which every `update()` runs exactly one fixed step of
 /// `dt` seconds. The first update (which runs `Startup` and no step) has already happened.
 pub fn headless_app(dt: f64) -> App {
+    headless_app_with_threads(dt, None)
+}
+
+/// [`headless_app`] with the compute pool (which runs the parallel parts of the stages) set to
+/// `compute_threads` threads. Bevy's task pools belong to the process: only the first app in
+/// a process sets them.
+pub fn headless_app_with_threads(dt: f64, compute_threads: Option<usize>) -> App {
+    let mut task_pool_options = TaskPoolOptions::default();
+    if let Some(threads) = compute_threads {
+        task_pool_options.compute.min_threads = threads;
+        task_pool_options.compute.max_threads = threads;
+    }
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, SimPlugin))
-        .insert_resource(Time::<Fixed>::from_seconds(dt))
-        .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+    app.add_plugins((
+        MinimalPlugins.set(TaskPoolPlugin { task_pool_options }),
+        SimPlugin,
+    ))
+    .insert_resource(Time::<Fixed>::from_seconds(dt))
+    .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
     // Virtual time clamps each frame to `max_delta`; one frame must be able to hold a step.
     app.world_mut()
         .resource_mut::<Time<Virtual>>()
@@ -78,7 +94,18 @@ impl RunReport {
 /// Loads `setup` into a fresh headless app and runs `steps` fixed steps of `dt` seconds,
 /// timing each. Returns the app (for dumps and further checks) and the report.
 pub fn run_scene(setup: &SceneSetup, steps: u64, dt: f64) -> (App, RunReport) {
-    let mut app = headless_app(dt);
+    run_scene_with_threads(setup, steps, dt, None)
+}
+
+/// [`run_scene`] with the compute pool set to `compute_threads` threads (see
+/// [`headless_app_with_threads`]).
+pub fn run_scene_with_threads(
+    setup: &SceneSetup,
+    steps: u64,
+    dt: f64,
+    compute_threads: Option<usize>,
+) -> (App, RunReport) {
+    let mut app = headless_app_with_threads(dt, compute_threads);
     setup.apply(app.world_mut());
     let start = StateSummary::measure(app.world_mut());
     let mut step_times = Vec::with_capacity(steps as usize);

@@ -6,8 +6,10 @@
 //! - [`render`]: drawing the simulation in a window (reads its state only).
 //! - [`ui`]: the egui panel, mouse and keys.
 //! - [`play`]: the windowed toy.
+//! - [`bench`]: the standard gas timed at several sizes.
 //! - [`cli`]: the `ballpit` command line.
 
+pub mod bench;
 pub mod cli;
 pub mod headless;
 pub mod play;

@@ -192,3 +192,37 @@ fn runtime_errors_exit_1_naming_the_cause() {
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
     }
 }
+
+#[test]
+fn the_same_run_with_one_thread_or_three_is_bit_identical() {
+    let dir = std::env::temp_dir().join(format!("ballpit-threads-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dump = |threads: &str| {
+        let path = dir.join(format!("{threads}.json"));
+        let out = ballpit(&[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--balls",
+            "30000",
+            "--steps",
+            "20",
+            "--json",
+            "--threads",
+            threads,
+            "--dump",
+            path.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read(&path).unwrap()
+    };
+    let one = dump("1");
+    let three = dump("3");
+    assert!(one.len() > 1_000_000);
+    assert!(one == three, "the dumps differ");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -86,33 +86,46 @@ impl UniformGrid {
         }
     }
 
+    /// Rows of cells: the unit [`for_each_candidate_pair_in_rows`](Self::for_each_candidate_pair_in_rows)
+    /// splits work by.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
     /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls in the same or
     /// adjacent cells, in a fixed order (cell by cell, row-major). Indices are the positions
     /// in the slice given to [`rebuild`](Self::rebuild).
-    pub fn for_each_candidate_pair(&self, mut visit: impl FnMut(u32, u32, Circle, Circle)) {
-        for row in 0..self.rows {
+    pub fn for_each_candidate_pair(&self, visit: impl FnMut(u32, u32, Circle, Circle)) {
+        self.for_each_candidate_pair_in_rows(0..self.rows, visit);
+    }
+
+    /// The pairs [`for_each_candidate_pair`](Self::for_each_candidate_pair) visits from the
+    /// cells of `rows`, in the same order. Disjoint row ranges visit disjoint pairs, so bands
+    /// of rows can be searched in parallel and their results joined in row order.
+    pub fn for_each_candidate_pair_in_rows(
+        &self,
+        rows: std::ops::Range<usize>,
+        mut visit: impl FnMut(u32, u32, Circle, Circle),
+    ) {
+        for row in rows {
             for column in 0..self.columns {
                 let here = self.cell_range(column as isize, row as isize);
+                if here.is_empty() {
+                    continue;
+                }
+                let neighbours = FORWARD_NEIGHBOURS
+                    .map(|(dc, dr)| self.cell_range(column as isize + dc, row as isize + dr));
                 for slot in here.clone() {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-                    for other in slot + 1..here.end {
+                    let others =
+                        (slot + 1..here.end).chain(neighbours.iter().flat_map(|r| r.clone()));
+                    for other in others {
                         visit(
                             index,
                             self.sorted_index[other],
                             circle,
                             self.sorted_circle[other],
                         );
-                    }
-                    for (dc, dr) in FORWARD_NEIGHBOURS {
-                        let there = self.cell_range(column as isize + dc, row as isize + dr);
-                        for other in there {
-                            visit(
-                                index,
-                                self.sorted_index[other],
-                                circle,
-                                self.sorted_circle[other],
-                            );
-                        }
                     }
                 }
             }

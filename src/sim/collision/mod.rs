@@ -8,6 +8,7 @@ pub mod broad_phase;
 pub mod narrow_phase;
 
 use bevy::prelude::*;
+use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 use super::SimSystems;
 use super::ball::{Ball, Position, Radius};
@@ -46,15 +47,51 @@ pub struct IndexedContact {
     pub geometry: ContactGeometry,
 }
 
+/// Below this many balls the grid search runs on one thread: splitting costs more than it saves.
+const PARALLEL_MIN_BALLS: usize = 20_000;
+/// Bands of rows per worker thread, so an unlucky band does not leave a thread idle.
+const BANDS_PER_THREAD: usize = 4;
+
 /// Finds every touching pair among `circles` and appends it to `found`, each pair once with
-/// `a < b` and the normal from `a` to `b`. The order is fixed by the input and the method.
+/// `a < b` and the normal from `a` to `b`. The order is fixed by the input and the method,
+/// whatever the number of threads: the grid is searched in bands of rows, in parallel for
+/// large inputs, and the bands' contacts are joined in row order.
 pub fn find_contacts(
     circles: &[Circle],
     method: BroadPhase,
     grid: &mut UniformGrid,
     found: &mut Vec<IndexedContact>,
 ) {
-    let keep_touching = |i: u32, j: u32, ci: Circle, cj: Circle| {
+    match method {
+        BroadPhase::Grid => {
+            grid.rebuild(circles);
+            if circles.len() < PARALLEL_MIN_BALLS {
+                grid.for_each_candidate_pair(keep_touching(found));
+                return;
+            }
+            let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+            let band_count = (pool.thread_num() * BANDS_PER_THREAD).max(1);
+            let rows = grid.rows();
+            let grid = &*grid;
+            let bands: Vec<Vec<IndexedContact>> = pool.scope(|scope| {
+                for band in 0..band_count {
+                    let band_rows = rows * band / band_count..rows * (band + 1) / band_count;
+                    scope.spawn(async move {
+                        let mut local = Vec::new();
+                        grid.for_each_candidate_pair_in_rows(band_rows, keep_touching(&mut local));
+                        local
+                    });
+                }
+            });
+            found.extend(bands.into_iter().flatten());
+        }
+        BroadPhase::AllPairs => for_each_pair(circles, keep_touching(found)),
+    }
+}
+
+/// A visitor for the broad phase that runs the narrow phase and keeps touching pairs.
+fn keep_touching(found: &mut Vec<IndexedContact>) -> impl FnMut(u32, u32, Circle, Circle) + '_ {
+    move |i, j, ci, cj| {
         let (a, b, ca, cb) = if i < j {
             (i, j, ci, cj)
         } else {
@@ -63,13 +100,6 @@ pub fn find_contacts(
         if let Some(geometry) = circle_contact(ca, cb) {
             found.push(IndexedContact { a, b, geometry });
         }
-    };
-    match method {
-        BroadPhase::Grid => {
-            grid.rebuild(circles);
-            grid.for_each_candidate_pair(keep_touching);
-        }
-        BroadPhase::AllPairs => for_each_pair(circles, keep_touching),
     }
 }
 
@@ -110,4 +140,40 @@ fn detect_contacts(
         depth: contact.geometry.depth,
         point: contact.geometry.point,
     }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy::math::DVec2;
+
+    #[test]
+    fn parallel_grid_search_gives_the_sequential_order() {
+        // A jittered lattice, dense enough to touch often, large enough to run in parallel.
+        let side = 200;
+        let circles: Vec<Circle> = (0..side * side)
+            .map(|k| {
+                let (x, y) = ((k % side) as f64, (k / side) as f64);
+                let jitter = ((k * 7919) % 13) as f64 * 0.1;
+                Circle::new(
+                    DVec2::new(x * 9.0 + jitter, y * 9.0 - jitter),
+                    4.0 + jitter * 0.2,
+                )
+            })
+            .collect();
+        assert!(circles.len() >= PARALLEL_MIN_BALLS);
+        let mut parallel = Vec::new();
+        find_contacts(
+            &circles,
+            BroadPhase::Grid,
+            &mut UniformGrid::default(),
+            &mut parallel,
+        );
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut sequential = Vec::new();
+        grid.for_each_candidate_pair(keep_touching(&mut sequential));
+        assert!(sequential.len() > 10_000, "{} contacts", sequential.len());
+        assert_eq!(parallel, sequential);
+    }
 }

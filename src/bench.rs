@@ -1,0 +1,200 @@
+//! `ballpit bench`: the standard gas (`assets/scenes/gas.ron`: radius U[5, 15] px, speed
+//! U[0, 500] px/s, area fraction 0.30, dt 1/60 s) at several sizes, with figures per size.
+//!
+//! Each case runs in a child process (`ballpit bench-one`), so its peak memory is its own and
+//! its core count can be set: one-core cases are started under `taskset -c 0`, which Bevy's
+//! task pools see as one available core. Timings are compared as ratios within one run.
+
+use std::error::Error;
+use std::process::Command;
+use std::time::Instant;
+
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::headless::{DEFAULT_DT, headless_app_with_threads};
+use crate::sim::{BroadPhase, Contacts, SceneFile, SimParams};
+
+/// The standard gas, built in so the bench runs from any directory.
+pub const STANDARD_GAS: &str = include_str!("../assets/scenes/gas.ron");
+/// Steps run before timing starts (first-touch allocations, caches).
+const WARM_UP_STEPS: u64 = 5;
+
+/// One case: how many balls, how many timed steps, which broad phase.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchCase {
+    pub balls: usize,
+    pub steps: u64,
+    pub broad_phase: BroadPhase,
+}
+
+/// What one case measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseResult {
+    pub case: BenchCase,
+    /// Cores the process could use.
+    pub cores: usize,
+    /// Worker threads of the compute pool.
+    pub threads: usize,
+    pub ms_per_step_median: f64,
+    pub ns_per_ball_step: f64,
+    pub contacts_per_step: f64,
+    /// Peak resident memory of the process, MiB (Linux only).
+    pub peak_rss_mib: Option<f64>,
+}
+
+/// Runs `case` in this process with `threads` worker threads.
+pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn Error>> {
+    let mut scene = SceneFile::parse(STANDARD_GAS, "gas.ron")?;
+    if let Some(generate) = scene.generate.as_mut() {
+        generate.count = case.balls;
+    }
+    let setup = scene.build("gas.ron")?;
+    let mut app = headless_app_with_threads(DEFAULT_DT, Some(threads));
+    setup.apply(app.world_mut());
+    app.world_mut().resource_mut::<SimParams>().broad_phase = case.broad_phase;
+    for _ in 0..WARM_UP_STEPS {
+        app.update();
+    }
+    let mut step_ms = Vec::with_capacity(case.steps as usize);
+    let mut contacts = 0usize;
+    for _ in 0..case.steps {
+        let started = Instant::now();
+        app.update();
+        step_ms.push(started.elapsed().as_secs_f64() * 1e3);
+        contacts += app.world().resource::<Contacts>().0.len();
+    }
+    step_ms.sort_by(f64::total_cmp);
+    let median = step_ms.get(step_ms.len() / 2).copied().unwrap_or(0.0);
+    Ok(CaseResult {
+        case,
+        cores: available_cores(),
+        threads,
+        ms_per_step_median: median,
+        ns_per_ball_step: median * 1e6 / case.balls.max(1) as f64,
+        contacts_per_step: contacts as f64 / case.steps.max(1) as f64,
+        peak_rss_mib: peak_rss_mib(),
+    })
+}
+
+/// Cores this process may run on (fewer under `taskset`).
+pub fn available_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The process's peak resident set size, MiB, from `/proc/self/status` (Linux).
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|line| line.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// Runs `case` in a child process: on one core with one worker thread if `one_core` (via
+/// `taskset`), else with a worker thread per core.
+pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, Box<dyn Error>> {
+    let threads = if one_core { 1 } else { available_cores() };
+    let exe = std::env::current_exe()?;
+    let mut command = if one_core {
+        let mut taskset = Command::new("taskset");
+        taskset.args(["-c", "0"]).arg(exe);
+        taskset
+    } else {
+        Command::new(exe)
+    };
+    let broad_phase = match case.broad_phase {
+        BroadPhase::Grid => "grid",
+        BroadPhase::AllPairs => "all-pairs",
+    };
+    let output = command
+        .args([
+            "bench-one",
+            "--balls",
+            &case.balls.to_string(),
+            "--steps",
+            &case.steps.to_string(),
+        ])
+        .args([
+            "--broad-phase",
+            broad_phase,
+            "--threads",
+            &threads.to_string(),
+        ])
+        .output()
+        .map_err(|e| {
+            format!(
+                "cannot start the bench child{}: {e}",
+                if one_core {
+                    " (is taskset installed?)"
+                } else {
+                    ""
+                }
+            )
+        })?;
+    if !output.status.success() {
+        return Err(format!(
+            "bench child failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        )
+        .into());
+    }
+    Ok(serde_json::from_slice(&output.stdout)?)
+}
+
+/// One row of the bench table: a size, on one core and on all cores, against all pairs.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchRow {
+    pub balls: usize,
+    pub one_core: CaseResult,
+    pub all_cores: CaseResult,
+    /// The all-pairs reference on one core, where it was run.
+    pub all_pairs: Option<CaseResult>,
+}
+
+impl BenchRow {
+    pub fn speedup_over_all_pairs(&self) -> Option<f64> {
+        self.all_pairs
+            .as_ref()
+            .map(|all| all.ms_per_step_median / self.one_core.ms_per_step_median)
+    }
+
+    pub fn speedup_from_cores(&self) -> f64 {
+        self.one_core.ms_per_step_median / self.all_cores.ms_per_step_median
+    }
+}
+
+/// The bench table as text.
+pub fn format_table(rows: &[BenchRow]) -> String {
+    let mut text = format!(
+        "{:>8} {:>12} {:>14} {:>14} {:>12} {:>10} {:>13} {:>11}\n",
+        "balls",
+        "ms/step 1c",
+        "ns/ball-step",
+        "contacts/step",
+        "peak RSS MB",
+        "ms/step 2c",
+        "speed-up 2c",
+        "vs all-pairs"
+    );
+    for row in rows {
+        let rss = row
+            .one_core
+            .peak_rss_mib
+            .map_or("-".to_string(), |mib| format!("{:.1}", mib * 1.048_576));
+        let versus = row
+            .speedup_over_all_pairs()
+            .map_or("-".to_string(), |s| format!("{s:.1}x"));
+        text += &format!(
+            "{:>8} {:>12.3} {:>14.1} {:>14.0} {:>12} {:>10.3} {:>12.2}x {:>11}\n",
+            row.balls,
+            row.one_core.ms_per_step_median,
+            row.one_core.ns_per_ball_step,
+            row.one_core.contacts_per_step,
+            rss,
+            row.all_cores.ms_per_step_median,
+            row.speedup_from_cores(),
+            versus
+        );
+    }
+    text
+}
