@@ -47,6 +47,12 @@ pub struct PlayArgs {
     /// Save a PNG of the window after `--frames` frames, then exit.
     #[arg(long, value_name = "OUT.png")]
     pub screenshot: Option<PathBuf>,
+    /// Override the scene's `generate.count`.
+    #[arg(long)]
+    pub balls: Option<usize>,
+    /// Override the scene's `generate.seed`.
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Frames to run before the screenshot.
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
@@ -163,14 +169,36 @@ impl Cli {
     }
 }
 
+/// Applies `--balls` and `--seed` to the scene's `generate`, which must exist.
+fn override_generation(
+    scene: &mut SceneFile,
+    origin: &str,
+    balls: Option<usize>,
+    seed: Option<u64>,
+) -> Result<(), Box<dyn Error>> {
+    if balls.is_none() && seed.is_none() {
+        return Ok(());
+    }
+    let Some(generate) = scene.generate.as_mut() else {
+        return Err(format!(
+            "{origin}: --balls and --seed override `generate`, which this scene lacks"
+        )
+        .into());
+    };
+    generate.count = balls.unwrap_or(generate.count);
+    generate.seed = seed.unwrap_or(generate.seed);
+    Ok(())
+}
+
 fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
-    let (file, origin) = match &args.scene {
+    let (mut file, origin) = match &args.scene {
         Some(path) => (SceneFile::load(path)?, path.display().to_string()),
         None => (
             SceneFile::parse(DEMO_SCENE, "demo.ron")?,
             "demo.ron".to_string(),
         ),
     };
+    override_generation(&mut file, &origin, args.balls, args.seed)?;
     // Refuse a bad scene here, with exit code 1, rather than in the window.
     file.build(&origin)?;
     let screenshot = args.screenshot.map(|path| (path, args.frames));
@@ -186,16 +214,7 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
 fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     let origin = args.scene.display().to_string();
     let mut scene = SceneFile::load(&args.scene)?;
-    if args.balls.is_some() || args.seed.is_some() {
-        let Some(generate) = scene.generate.as_mut() else {
-            return Err(format!(
-                "{origin}: --balls and --seed override `generate`, which this scene lacks"
-            )
-            .into());
-        };
-        generate.count = args.balls.unwrap_or(generate.count);
-        generate.seed = args.seed.unwrap_or(generate.seed);
-    }
+    override_generation(&mut scene, &origin, args.balls, args.seed)?;
     let setup = scene.build(&origin)?;
     let threads = args.threads.map(|n| n as usize);
     let (mut app, report) = run_scene_with_threads(&setup, args.steps, args.dt, threads);

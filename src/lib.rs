@@ -5,12 +5,13 @@
 //! - [`headless`]: step a scene without a window and measure it.
 //! - [`render`]: drawing the simulation in a window (reads its state only).
 //! - [`ui`]: the egui panel, mouse and keys.
-//! - [`play`]: the windowed toy.
+//! - [`play`]: the windowed toy; [`diagnostics`]: its frame and simulation timings.
 //! - [`bench`]: the standard gas timed at several sizes.
 //! - [`cli`]: the `ballpit` command line.
 
 pub mod bench;
 pub mod cli;
+pub mod diagnostics;
 pub mod headless;
 pub mod play;
 pub mod render;

@@ -8,6 +8,7 @@
 
 use std::path::PathBuf;
 
+use bevy::diagnostic::DiagnosticsStore;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
@@ -15,8 +16,8 @@ use bevy::window::{PrimaryWindow, WindowResolution};
 use rand::RngExt;
 
 use crate::render::{self, PlayArea};
-use crate::sim::{SceneFile, SimPlugin, SimRng};
-use crate::ui;
+use crate::sim::{Ball, SceneFile, SimPlugin, SimRng};
+use crate::{diagnostics, ui};
 
 /// Largest window the toy opens or resizes to, logical pixels.
 const MAX_WINDOW: Vec2 = Vec2::new(1600.0, 1000.0);
@@ -90,7 +91,7 @@ pub struct GamePlugin;
 
 impl Plugin for GamePlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins((SimPlugin, render::plugin, ui::plugin))
+        app.add_plugins((SimPlugin, render::plugin, ui::plugin, diagnostics::plugin))
             .insert_resource(Time::<Fixed>::from_hz(DEFAULT_STEP_RATE))
             .add_message::<SceneRequest>()
             .add_message::<SceneLoaded>()
@@ -110,7 +111,16 @@ fn window_size_for(scene: &CurrentScene) -> Vec2 {
         .map_or(Vec2::new(1280.0, 720.0), |setup| {
             setup.params.arena_size.as_vec2()
         });
-    (arena + Vec2::new(ui::PANEL_WIDTH, 0.0)).clamp(MIN_WINDOW, MAX_WINDOW)
+    fit_window(arena, ui::PANEL_WIDTH).0
+}
+
+/// The window size and zoom that show `arena` beside a panel `panel` pixels wide: the arena at
+/// one pixel per pixel if that fits the largest window, else zoomed out until it does.
+pub fn fit_window(arena: Vec2, panel: f32) -> (Vec2, f32) {
+    let room = MAX_WINDOW - Vec2::new(panel, 0.0);
+    let zoom = (arena / room).max_element().max(1.0);
+    let window = (arena / zoom + Vec2::new(panel, 0.0)).clamp(MIN_WINDOW, MAX_WINDOW);
+    (window, zoom)
 }
 
 fn handle_scene_requests(mut requests: MessageReader<SceneRequest>, mut commands: Commands) {
@@ -155,11 +165,13 @@ fn apply_scene_request(world: &mut World, request: SceneRequest) {
     }
 }
 
-/// Asks for a window that shows `arena` beside the panel. Until it arrives the arena keeps
-/// the scene's size; then it follows the window.
+/// Zooms and asks for a window that show `arena` beside the panel. Until the window arrives
+/// the arena keeps the scene's size; then it follows the window.
 fn resize_window_for(world: &mut World, arena: DVec2) {
-    let panel = world.resource::<PlayArea>().panel_width;
-    let wanted = (arena.as_vec2() + Vec2::new(panel, 0.0)).clamp(MIN_WINDOW, MAX_WINDOW);
+    let mut play_area = *world.resource::<PlayArea>();
+    let (wanted, zoom) = fit_window(arena.as_vec2(), play_area.panel_width);
+    play_area.zoom = zoom;
+    world.insert_resource(play_area);
     let mut windows = world.query_filtered::<&mut Window, With<PrimaryWindow>>();
     if let Ok(mut window) = windows.single_mut(world)
         && window.size() != wanted
@@ -182,6 +194,8 @@ const FRAMES_TO_GIVE_UP: u32 = 600;
 
 fn take_screenshot_and_exit(
     mut plan: ResMut<ScreenshotPlan>,
+    store: Res<DiagnosticsStore>,
+    balls: Query<(), With<Ball>>,
     mut frame: Local<u32>,
     mut commands: Commands,
     mut exit: MessageWriter<AppExit>,
@@ -193,6 +207,16 @@ fn take_screenshot_and_exit(
                 .spawn(Screenshot::primary_window())
                 .observe(save_to_disk(plan.path.clone()));
             plan.requested_at = Some(*frame);
+            let (frame_ms, fps, simulation_ms) = diagnostics::frame_figures(&store);
+            let show = |value: Option<f64>| value.map_or("-".to_string(), |v| format!("{v:.2}"));
+            println!(
+                "frame {}: {} balls, frame time {} ms ({} FPS), simulation {} ms per frame",
+                *frame,
+                balls.iter().len(),
+                show(frame_ms),
+                show(fps),
+                show(simulation_ms)
+            );
         }
         Some(requested) if *frame >= requested + FRAMES_TO_SAVE && plan.path.exists() => {
             exit.write(AppExit::Success);
@@ -202,5 +226,19 @@ fn take_screenshot_and_exit(
             exit.write(AppExit::error());
         }
         _ => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_arenas_show_one_to_one_and_large_ones_zoom_out() {
+        let (window, zoom) = fit_window(Vec2::new(800.0, 600.0), 300.0);
+        assert_eq!((window, zoom), (Vec2::new(1100.0, 600.0), 1.0));
+        let (window, zoom) = fit_window(Vec2::new(3000.0, 3000.0), 300.0);
+        assert_eq!(zoom, 3.0);
+        assert_eq!(window, Vec2::new(1300.0, 1000.0));
     }
 }

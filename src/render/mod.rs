@@ -80,10 +80,31 @@ impl Default for ViewSettings {
     }
 }
 
-/// Width of the window strip the side panel covers, logical pixels; the arena fills the rest.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+/// How the arena maps onto the window: the side panel covers a strip on the left and the
+/// rest shows the arena, `zoom` arena pixels to a window pixel (more than 1 for arenas larger
+/// than any window).
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
 pub struct PlayArea {
+    /// Logical pixels.
     pub panel_width: f32,
+    /// Arena pixels per window pixel, at least 1.
+    pub zoom: f32,
+}
+
+impl Default for PlayArea {
+    fn default() -> Self {
+        PlayArea {
+            panel_width: 0.0,
+            zoom: 1.0,
+        }
+    }
+}
+
+impl PlayArea {
+    /// The arena the window of `window_size` logical pixels shows.
+    pub fn arena_for_window(&self, window_size: Vec2) -> Vec2 {
+        (window_size - Vec2::new(self.panel_width, 0.0)).max(Vec2::ZERO) * self.zoom
+    }
 }
 
 /// The texture every ball sprite draws: a white disc with a one-texel soft edge.
@@ -227,21 +248,27 @@ fn fit_arena_to_window(
     play_area: Res<PlayArea>,
     mut params: ResMut<SimParams>,
 ) {
-    let width = (window.width() - play_area.panel_width).max(0.0);
-    let size = DVec2::new(width as f64, window.height() as f64);
+    let size = play_area.arena_for_window(window.size()).as_dvec2();
     if params.arena_size != size {
         params.arena_size = size;
     }
 }
 
-/// Shifts the camera so the arena (centred on the origin) sits right of the panel.
+/// Zooms the camera by the play area's zoom and shifts it so the arena (centred on the origin)
+/// sits right of the panel.
 fn place_camera_and_floor(
     play_area: Res<PlayArea>,
     params: Res<SimParams>,
-    mut camera: Single<&mut Transform, (With<Camera2d>, Without<ArenaFloor>)>,
+    mut camera: Single<(&mut Transform, &mut Projection), (With<Camera2d>, Without<ArenaFloor>)>,
     mut floor: Single<(&mut Transform, &mut Sprite), With<ArenaFloor>>,
 ) {
-    camera.translation.x = -play_area.panel_width / 2.0;
+    let (transform, projection) = &mut *camera;
+    transform.translation.x = -play_area.panel_width / 2.0 * play_area.zoom;
+    if let Projection::Orthographic(orthographic) = &mut **projection
+        && orthographic.scale != play_area.zoom
+    {
+        orthographic.scale = play_area.zoom;
+    }
     floor.0.translation = Vec3::new(0.0, 0.0, -1.0);
     floor.1.custom_size = Some(params.arena_size.as_vec2());
 }
@@ -262,6 +289,19 @@ mod tests {
             drawn_position(&previous, &position, 1.0),
             Vec2::new(10.0, -4.0)
         );
+    }
+
+    #[test]
+    fn the_arena_is_the_window_right_of_the_panel_times_the_zoom() {
+        let area = PlayArea {
+            panel_width: 200.0,
+            zoom: 2.0,
+        };
+        assert_eq!(
+            area.arena_for_window(Vec2::new(1000.0, 600.0)),
+            Vec2::new(1600.0, 1200.0)
+        );
+        assert_eq!(area.arena_for_window(Vec2::new(100.0, 0.0)), Vec2::ZERO);
     }
 
     #[test]

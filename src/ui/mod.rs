@@ -5,7 +5,6 @@
 pub mod input;
 pub mod panel;
 
-use bevy::diagnostic::FrameTimeDiagnosticsPlugin;
 use bevy::prelude::*;
 use bevy_egui::EguiPlugin;
 
@@ -15,11 +14,9 @@ use crate::render::PlayArea;
 pub const PANEL_WIDTH: f32 = 290.0;
 
 pub fn plugin(app: &mut App) {
-    if !app.is_plugin_added::<FrameTimeDiagnosticsPlugin>() {
-        app.add_plugins(FrameTimeDiagnosticsPlugin::default());
-    }
     app.insert_resource(PlayArea {
         panel_width: PANEL_WIDTH,
+        ..default()
     })
     .add_plugins(EguiPlugin::default())
     .add_plugins((panel::plugin, input::plugin));

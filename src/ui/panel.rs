@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
-use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
+use bevy::diagnostic::DiagnosticsStore;
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -16,6 +16,7 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
 use egui_plot::{Line, Plot, PlotPoints};
 
 use super::PANEL_WIDTH;
+use crate::diagnostics::frame_figures;
 use crate::play::{CurrentScene, SceneLoaded, SceneRequest, SceneStatus};
 use crate::render::{ColourMode, PlayArea, ViewSettings};
 use crate::sim::spawn::set_ball_count;
@@ -382,15 +383,16 @@ fn readouts(ui: &mut egui::Ui, shown: &Shown) {
     egui::CollapsingHeader::new("Readouts")
         .default_open(true)
         .show(ui, |ui| {
-            let fps = shown
-                .diagnostics
-                .get(&FrameTimeDiagnosticsPlugin::FPS)
-                .and_then(|fps| fps.smoothed())
-                .unwrap_or(0.0);
+            let (frame_ms, fps, simulation_ms) = frame_figures(&shown.diagnostics);
             let r = &shown.readouts;
             egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
                 for (name, value) in [
-                    ("FPS", format!("{fps:.0}")),
+                    ("FPS", format!("{:.0}", fps.unwrap_or(0.0))),
+                    ("frame ms", format!("{:.1}", frame_ms.unwrap_or(0.0))),
+                    (
+                        "simulation ms",
+                        format!("{:.1}", simulation_ms.unwrap_or(0.0)),
+                    ),
                     ("balls", format!("{}", r.balls)),
                     ("collisions /s", format!("{:.0}", r.collisions_per_second)),
                     ("kinetic energy", format!("{:.4e}", r.kinetic_energy)),
