@@ -91,9 +91,13 @@ fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
     for _ in 0..3 {
         app.update();
     }
+    // The gas (1,083 px square) is taller than the largest window: shown zoomed out.
     let panel = ballpit::ui::PANEL_WIDTH as f64;
+    let zoom = app.world().resource::<ballpit::render::PlayArea>().zoom as f64;
+    assert!(zoom > 1.0 && zoom < 1.1, "zoom {zoom}");
     let arena = app.world().resource::<SimParams>().arena_size;
-    assert_eq!(arena, bevy::math::DVec2::new(1400.0 - panel, 900.0));
+    let expected = bevy::math::DVec2::new(1400.0 - panel, 900.0) * zoom;
+    assert!((arena - expected).length() < 1e-3, "{arena} vs {expected}");
     app.world_mut()
         .get_mut::<Window>(window)
         .unwrap()
@@ -103,7 +107,8 @@ fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
         app.update();
     }
     let half = app.world().resource::<SimParams>().half_extents();
-    assert_eq!(half, bevy::math::DVec2::new((700.0 - panel) / 2.0, 250.0));
+    let expected = bevy::math::DVec2::new(700.0 - panel, 500.0) * zoom / 2.0;
+    assert!((half - expected).length() < 1e-3, "{half} vs {expected}");
     for ball in states(&mut app) {
         let reach = ball.position.abs() + bevy::math::DVec2::splat(ball.radius);
         assert!(
