@@ -10,6 +10,17 @@ fn ballpit(args: &[&str]) -> Output {
         .expect("the ballpit binary runs")
 }
 
+/// Runs ballpit and asserts it succeeded, showing its error output if not.
+fn ballpit_ok(args: &[&str]) -> Output {
+    let out = ballpit(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 const REPORT_FIELDS: [&str; 16] = [
     "steps",
     "sim_time_s",
@@ -31,7 +42,7 @@ const REPORT_FIELDS: [&str; 16] = [
 
 #[test]
 fn run_prints_a_json_report_with_every_field() {
-    let out = ballpit(&[
+    let out = ballpit_ok(&[
         "run",
         "--scene",
         "assets/scenes/gas.ron",
@@ -41,11 +52,6 @@ fn run_prints_a_json_report_with_every_field() {
         "200",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for field in REPORT_FIELDS {
         assert!(report.get(field).is_some(), "missing {field}");
@@ -65,14 +71,13 @@ fn run_prints_a_json_report_with_every_field() {
 
 #[test]
 fn run_prints_a_readable_report_by_default() {
-    let out = ballpit(&[
+    let out = ballpit_ok(&[
         "run",
         "--scene",
         "assets/scenes/head_on.ron",
         "--steps",
         "10",
     ]);
-    assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     for field in REPORT_FIELDS {
         assert!(
@@ -87,7 +92,7 @@ fn dump_writes_every_ball() {
     let dir = std::env::temp_dir().join(format!("ballpit-dump-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("state.json");
-    let out = ballpit(&[
+    ballpit_ok(&[
         "run",
         "--scene",
         "assets/scenes/newtons_cradle.ron",
@@ -97,11 +102,6 @@ fn dump_writes_every_ball() {
         "--dump",
         path.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let dump: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let balls = dump["balls"].as_array().unwrap();
@@ -199,7 +199,7 @@ fn the_same_run_with_one_thread_or_three_is_bit_identical() {
     std::fs::create_dir_all(&dir).unwrap();
     let dump = |threads: &str| {
         let path = dir.join(format!("{threads}.json"));
-        let out = ballpit(&[
+        ballpit_ok(&[
             "run",
             "--scene",
             "assets/scenes/gas.ron",
@@ -213,11 +213,6 @@ fn the_same_run_with_one_thread_or_three_is_bit_identical() {
             "--dump",
             path.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         std::fs::read(&path).unwrap()
     };
     let one = dump("1");
