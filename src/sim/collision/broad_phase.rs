@@ -12,10 +12,6 @@ use super::narrow_phase::Circle;
 /// arena cost little memory; the cells grow instead.
 const MAX_CELLS_PER_BALL: usize = 4;
 
-/// Neighbour cells visited from each cell, as (column, row) offsets. With the cell's own
-/// contents these four "forward" neighbours reach every adjacent cell pair exactly once.
-const FORWARD_NEIGHBOURS: [(isize, isize); 4] = [(1, 0), (-1, 1), (0, 1), (1, 1)];
-
 /// A uniform grid over the balls' centres, rebuilt from scratch every step by a counting sort.
 ///
 /// The cell side is at least the largest diameter, so two touching circles always sit in the
@@ -107,19 +103,32 @@ impl UniformGrid {
         rows: std::ops::Range<usize>,
         mut visit: impl FnMut(u32, u32, Circle, Circle),
     ) {
+        // In row-major order a cell and its right neighbour are adjacent, and the three cells
+        // above (left, centre, right) are one contiguous run: each ball's candidates are two
+        // contiguous slot ranges, the rest of its own cell with the right cell, and the run above.
+        let columns = self.columns;
         for row in rows {
-            for column in 0..self.columns {
-                let here = self.cell_range(column as isize, row as isize);
-                if here.is_empty() {
+            for column in 0..columns {
+                let cell = row * columns + column;
+                let (start, end) = (
+                    self.cell_start[cell] as usize,
+                    self.cell_start[cell + 1] as usize,
+                );
+                if start == end {
                     continue;
                 }
-                let neighbours = FORWARD_NEIGHBOURS
-                    .map(|(dc, dr)| self.cell_range(column as isize + dc, row as isize + dr));
-                for slot in here.clone() {
+                let same_row_end =
+                    self.cell_start[cell + usize::from(column + 1 < columns) + 1] as usize;
+                let above = if row + 1 < self.rows {
+                    let first = cell + columns - usize::from(column > 0);
+                    let last = cell + columns + usize::from(column + 1 < columns);
+                    self.cell_start[first] as usize..self.cell_start[last + 1] as usize
+                } else {
+                    0..0
+                };
+                for slot in start..end {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-                    let others =
-                        (slot + 1..here.end).chain(neighbours.iter().flat_map(|r| r.clone()));
-                    for other in others {
+                    for other in (slot + 1..same_row_end).chain(above.clone()) {
                         visit(
                             index,
                             self.sorted_index[other],
@@ -137,14 +146,6 @@ impl UniformGrid {
         let column = (((center.x - self.origin.x) / self.cell_size) as usize).min(self.columns - 1);
         let row = (((center.y - self.origin.y) / self.cell_size) as usize).min(self.rows - 1);
         row * self.columns + column
-    }
-
-    fn cell_range(&self, column: isize, row: isize) -> std::ops::Range<usize> {
-        if column < 0 || row < 0 || column as usize >= self.columns || row as usize >= self.rows {
-            return 0..0;
-        }
-        let cell = row as usize * self.columns + column as usize;
-        self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize
     }
 }
 
