@@ -4,15 +4,16 @@
 //!
 //! Runs in [`SimSystems::Response`](super::SimSystems::Response), reading [`Contacts`] in
 //! their stable order (Gauss–Seidel: each contact sees the velocities the earlier ones left).
-//! Writes a [`BallCollision`] per exchange.
+//! Works on the collision stage's contiguous [`BallSnapshot`] by index, then writes the balls
+//! that changed back to their components in one pass. Writes a [`BallCollision`] per exchange.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::SimSystems;
-use super::ball::{Position, Radius, Velocity};
-use super::collision::Contacts;
+use super::ball::{Ball, Position, Velocity};
 use super::collision::narrow_phase::{Circle, circle_contact};
+use super::collision::{BallSnapshot, Contacts};
 use super::messages::BallCollision;
 use super::movement::bounce_off_walls;
 use super::params::SimParams;
@@ -86,38 +87,36 @@ pub fn separation_shares(depth: f64, inverse_mass_a: f64, inverse_mass_b: f64) -
 fn resolve_contacts(
     contacts: Res<Contacts>,
     params: Res<SimParams>,
-    mut balls: Query<(&mut Position, &mut Velocity, &Radius)>,
+    mut snapshot: ResMut<BallSnapshot>,
+    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
     mut collisions: MessageWriter<BallCollision>,
 ) {
+    if contacts.0.is_empty() {
+        return;
+    }
+    let BallSnapshot {
+        entities,
+        circles,
+        velocities,
+    } = &mut *snapshot;
     for contact in &contacts.0 {
-        let Ok(
-            [
-                (mut position_a, mut velocity_a, radius_a),
-                (mut position_b, mut velocity_b, radius_b),
-            ],
-        ) = balls.get_many_mut([contact.a, contact.b])
-        else {
-            continue;
-        };
+        let (a, b) = (contact.index_a as usize, contact.index_b as usize);
         // Earlier contacts may have moved either ball: work from where they are now.
-        let Some(geometry) = circle_contact(
-            Circle::new(position_a.0, radius_a.0),
-            Circle::new(position_b.0, radius_b.0),
-        ) else {
+        let Some(geometry) = circle_contact(circles[a], circles[b]) else {
             continue;
         };
-        let inverse_mass_a = params.mass_model.inverse_mass(radius_a.0);
-        let inverse_mass_b = params.mass_model.inverse_mass(radius_b.0);
+        let inverse_mass_a = params.mass_model.inverse_mass(circles[a].radius);
+        let inverse_mass_b = params.mass_model.inverse_mass(circles[b].radius);
         if let Some(exchange) = normal_exchange(
-            velocity_a.0,
-            velocity_b.0,
+            velocities[a],
+            velocities[b],
             inverse_mass_a,
             inverse_mass_b,
             geometry.normal,
             params.restitution,
         ) {
-            velocity_a.0 = exchange.velocity_a;
-            velocity_b.0 = exchange.velocity_b;
+            velocities[a] = exchange.velocity_a;
+            velocities[b] = exchange.velocity_b;
             collisions.write(BallCollision {
                 a: contact.a,
                 b: contact.b,
@@ -128,8 +127,37 @@ fn resolve_contacts(
             });
         }
         let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
-        position_a.0 -= geometry.normal * back;
-        position_b.0 += geometry.normal * forward;
+        circles[a].center -= geometry.normal * back;
+        circles[b].center += geometry.normal * forward;
+    }
+    write_back(entities, circles, velocities, &mut balls);
+}
+
+/// Copies the snapshot's positions and velocities back to the components, touching only the
+/// balls that changed. The query visits the balls in the snapshot's order (nothing spawns or
+/// despawns within a step); a ball out of step is looked up by entity instead.
+fn write_back(
+    entities: &[Entity],
+    circles: &[Circle],
+    velocities: &[DVec2],
+    balls: &mut Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+) {
+    let mut in_order = true;
+    for (index, (entity, mut position, mut velocity)) in balls.iter_mut().enumerate() {
+        if entities.get(index) != Some(&entity) {
+            in_order = false;
+            break;
+        }
+        position.set_if_neq(Position(circles[index].center));
+        velocity.set_if_neq(Velocity(velocities[index]));
+    }
+    if !in_order {
+        for (index, &entity) in entities.iter().enumerate() {
+            if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity) {
+                position.set_if_neq(Position(circles[index].center));
+                velocity.set_if_neq(Velocity(velocities[index]));
+            }
+        }
     }
 }
 

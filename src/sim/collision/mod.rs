@@ -1,17 +1,19 @@
 //! Stage 2, collision: find every touching pair and record it as a [`Contact`].
 //!
 //! Runs in [`SimSystems::Collision`](super::SimSystems::Collision), after movement and before
-//! response. The broad phase proposes candidate pairs, the narrow phase's AABB test and exact
-//! squared-distance test keep the touching ones. Writes [`Contacts`]; changes no ball.
+//! response. Copies every ball into the contiguous [`BallSnapshot`]; the broad phase proposes
+//! candidate pairs, the narrow phase's AABB test and exact squared-distance test keep the
+//! touching ones. Writes [`Contacts`] and the snapshot; changes no ball.
 
 pub mod broad_phase;
 pub mod narrow_phase;
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 use super::SimSystems;
-use super::ball::{Ball, Position, Radius};
+use super::ball::{Ball, Position, Radius, Velocity};
 use super::params::{BroadPhase, SimParams};
 use broad_phase::{UniformGrid, for_each_pair};
 use narrow_phase::{Circle, ContactGeometry, circle_contact};
@@ -19,6 +21,7 @@ use narrow_phase::{Circle, ContactGeometry, circle_contact};
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Contacts>()
         .init_resource::<CollisionScratch>()
+        .init_resource::<BallSnapshot>()
         .add_systems(FixedUpdate, detect_contacts.in_set(SimSystems::Collision));
 }
 
@@ -27,17 +30,30 @@ pub(super) fn plugin(app: &mut App) {
 pub struct Contact {
     pub a: Entity,
     pub b: Entity,
+    /// Where `a` and `b` sit in this step's [`BallSnapshot`].
+    pub index_a: u32,
+    pub index_b: u32,
     /// Unit vector from `a`'s centre towards `b`'s.
-    pub normal: bevy::math::DVec2,
+    pub normal: DVec2,
     /// Overlap along the normal, pixels.
     pub depth: f64,
     /// The radius-weighted collision point, pixels.
-    pub point: bevy::math::DVec2,
+    pub point: DVec2,
 }
 
 /// This step's contacts, in a stable order: the response processes them in this order.
 #[derive(Resource, Debug, Default)]
 pub struct Contacts(pub Vec<Contact>);
+
+/// Every ball as the collision stage found it, in query order, in contiguous arrays: what the
+/// response works on by index before writing the results back to the components.
+#[derive(Resource, Debug, Default)]
+pub struct BallSnapshot {
+    pub entities: Vec<Entity>,
+    pub circles: Vec<Circle>,
+    /// Pixels per second.
+    pub velocities: Vec<DVec2>,
+}
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,29 +122,30 @@ fn keep_touching(found: &mut Vec<IndexedContact>) -> impl FnMut(u32, u32, Circle
 /// Buffers the collision stage keeps between steps.
 #[derive(Resource, Default)]
 struct CollisionScratch {
-    entities: Vec<Entity>,
-    circles: Vec<Circle>,
     grid: UniformGrid,
     found: Vec<IndexedContact>,
 }
 
 fn detect_contacts(
-    balls: Query<(Entity, &Position, &Radius), With<Ball>>,
+    balls: Query<(Entity, &Position, &Velocity, &Radius), With<Ball>>,
     params: Res<SimParams>,
     mut scratch: ResMut<CollisionScratch>,
+    mut snapshot: ResMut<BallSnapshot>,
     mut contacts: ResMut<Contacts>,
 ) {
-    let CollisionScratch {
+    let CollisionScratch { grid, found } = &mut *scratch;
+    let BallSnapshot {
         entities,
         circles,
-        grid,
-        found,
-    } = &mut *scratch;
+        velocities,
+    } = &mut *snapshot;
     entities.clear();
     circles.clear();
-    for (entity, position, radius) in &balls {
+    velocities.clear();
+    for (entity, position, velocity, radius) in &balls {
         entities.push(entity);
         circles.push(Circle::new(position.0, radius.0));
+        velocities.push(velocity.0);
     }
     found.clear();
     find_contacts(circles, params.broad_phase, grid, found);
@@ -136,6 +153,8 @@ fn detect_contacts(
     contacts.0.extend(found.iter().map(|contact| Contact {
         a: entities[contact.a as usize],
         b: entities[contact.b as usize],
+        index_a: contact.a,
+        index_b: contact.b,
         normal: contact.geometry.normal,
         depth: contact.geometry.depth,
         point: contact.geometry.point,
