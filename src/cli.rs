@@ -200,10 +200,11 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
     };
     override_generation(&mut file, &origin, args.balls, args.seed)?;
     // Refuse a bad scene here, with exit code 1, rather than in the window.
-    file.build(&origin)?;
+    let arena = file.build(&origin)?.params.arena_size.as_vec2();
     let screenshot = args.screenshot.map(|path| (path, args.frames));
     match play(PlayOptions {
         scene: CurrentScene { file, origin },
+        arena,
         screenshot,
     }) {
         bevy::app::AppExit::Success => Ok(()),

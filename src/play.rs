@@ -29,6 +29,8 @@ const DEFAULT_STEP_RATE: f64 = 60.0;
 /// What to play and whether to take a screenshot and quit.
 pub struct PlayOptions {
     pub scene: CurrentScene,
+    /// The scene's arena, pixels (from validating it): sizes the window.
+    pub arena: Vec2,
     /// Save a PNG of the window after `frames` frames, then exit.
     pub screenshot: Option<(PathBuf, u32)>,
 }
@@ -61,7 +63,7 @@ pub struct SceneStatus(pub Option<String>);
 
 /// Opens the window and runs until it is closed (or the screenshot is saved).
 pub fn play(options: PlayOptions) -> AppExit {
-    let window = window_size_for(&options.scene);
+    let window = fit_window(options.arena, ui::PANEL_WIDTH).0;
     let mut app = App::new();
     app.add_plugins(DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {
@@ -101,17 +103,6 @@ impl Plugin for GamePlugin {
             })
             .add_systems(Update, handle_scene_requests);
     }
-}
-
-/// The window that shows `scene`'s arena beside the panel, within the size limits.
-fn window_size_for(scene: &CurrentScene) -> Vec2 {
-    let arena = scene
-        .file
-        .build(&scene.origin)
-        .map_or(Vec2::new(1280.0, 720.0), |setup| {
-            setup.params.arena_size.as_vec2()
-        });
-    fit_window(arena, ui::PANEL_WIDTH).0
 }
 
 /// The window size and zoom that show `arena` beside a panel `panel` pixels wide: the arena at
