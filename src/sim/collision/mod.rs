@@ -16,7 +16,7 @@ use super::SimSystems;
 use super::ball::{Ball, Position, Radius, Velocity};
 use super::params::{BroadPhase, SimParams};
 use broad_phase::{UniformGrid, for_each_pair};
-use narrow_phase::{Circle, ContactGeometry, circle_contact};
+use narrow_phase::{Circle, ContactGeometry, circle_contact, circles_touch};
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Contacts>()
@@ -108,6 +108,9 @@ pub fn find_contacts(
 /// A visitor for the broad phase that runs the narrow phase and keeps touching pairs.
 fn keep_touching(found: &mut Vec<IndexedContact>) -> impl FnMut(u32, u32, Circle, Circle) + '_ {
     move |i, j, ci, cj| {
+        if !circles_touch(ci, cj) {
+            return;
+        }
         let (a, b, ca, cb) = if i < j {
             (i, j, ci, cj)
         } else {
