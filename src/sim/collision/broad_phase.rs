@@ -19,7 +19,7 @@ const MAX_CELLS_PER_BALL: usize = 4;
 #[derive(Debug, Default)]
 pub struct UniformGrid {
     origin: DVec2,
-    cell_size: f64,
+    inverse_cell_size: f64,
     columns: usize,
     rows: usize,
     /// `cell_start[c]..cell_start[c + 1]` is cell `c`'s range in `sorted_*`.
@@ -50,35 +50,38 @@ impl UniformGrid {
             .max((extent.x * extent.y / max_cells as f64).sqrt())
             .max(f64::MIN_POSITIVE);
         self.origin = min;
-        self.cell_size = cell_size;
         // The caps only bind for non-finite extents; clamping cells together never separates
         // two touching balls by more than one cell, so no pair is lost.
         self.columns = cells_along(extent.x, cell_size).min(max_cells);
         self.rows = cells_along(extent.y, cell_size).min((max_cells / self.columns).max(1));
         let cell_count = self.columns * self.rows;
 
+        self.inverse_cell_size = 1.0 / cell_size;
         self.cell_start.clear();
         self.cell_start.resize(cell_count + 1, 0);
         self.cell_of.clear();
         for circle in circles {
             let cell = self.cell_index(circle.center);
             self.cell_of.push(cell as u32);
-            self.cell_start[cell + 1] += 1;
+            self.cell_start[cell] += 1;
         }
-        for cell in 0..cell_count {
-            self.cell_start[cell + 1] += self.cell_start[cell];
+        // Inclusive prefix sums: each entry becomes its cell's end. Scattering the balls in
+        // reverse then counts each entry down to its cell's start, keeping the balls of a cell
+        // in their input order, with no second copy of the table.
+        let mut running = 0;
+        for count in &mut self.cell_start[..cell_count] {
+            running += *count;
+            *count = running;
         }
-        let mut cursor = self.cell_start.clone();
-        self.sorted_index.clear();
+        self.cell_start[cell_count] = circles.len() as u32;
         self.sorted_index.resize(circles.len(), 0);
-        self.sorted_circle.clear();
         self.sorted_circle
             .resize(circles.len(), Circle::new(DVec2::ZERO, 0.0));
-        for (index, (&cell, circle)) in self.cell_of.iter().zip(circles).enumerate() {
-            let slot = cursor[cell as usize] as usize;
-            cursor[cell as usize] += 1;
-            self.sorted_index[slot] = index as u32;
-            self.sorted_circle[slot] = *circle;
+        for (index, (&cell, circle)) in self.cell_of.iter().zip(circles).enumerate().rev() {
+            let slot = &mut self.cell_start[cell as usize];
+            *slot -= 1;
+            self.sorted_index[*slot as usize] = index as u32;
+            self.sorted_circle[*slot as usize] = *circle;
         }
     }
 
@@ -143,8 +146,9 @@ impl UniformGrid {
 
     fn cell_index(&self, center: DVec2) -> usize {
         // `as usize` saturates (and maps NaN to 0), so a stray value cannot index out of range.
-        let column = (((center.x - self.origin.x) / self.cell_size) as usize).min(self.columns - 1);
-        let row = (((center.y - self.origin.y) / self.cell_size) as usize).min(self.rows - 1);
+        let cell = (center - self.origin) * self.inverse_cell_size;
+        let column = (cell.x as usize).min(self.columns - 1);
+        let row = (cell.y as usize).min(self.rows - 1);
         row * self.columns + column
     }
 }
