@@ -1,8 +1,8 @@
 //! Stage 1, movement: integrate every ball's velocity and position over the step, then keep it
 //! in the arena by bouncing it off the walls.
 //!
-//! Runs in [`SimSystems::Movement`](super::SimSystems::Movement). The wall bounce is also run
-//! at the end of the response stage, because separating balls can push one into a wall.
+//! Runs in [`SimSystems::Movement`](super::SimSystems::Movement). The response stage applies
+//! the same [`contain_in_arena`] to the balls it separated, since that can push one into a wall.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -130,7 +130,7 @@ fn integrate_motion(
 }
 
 /// Keeps every ball inside the arena, writing a [`WallCollision`] per bounce.
-pub(super) fn bounce_off_walls(
+fn bounce_off_walls(
     params: Res<SimParams>,
     mut balls: Query<(Entity, &mut Position, &mut Velocity, &Radius), With<Ball>>,
     mut wall_hits: MessageWriter<WallCollision>,
@@ -143,18 +143,34 @@ pub(super) fn bounce_off_walls(
             continue;
         }
         (position.0, velocity.0) = (contained.position, contained.velocity);
-        for hit in contained.hits.into_iter().flatten() {
-            wall_hits.write(WallCollision {
-                ball,
-                wall: hit.wall,
-                point: wall_contact_point(hit.wall, position.0, half),
-                impulse: params.mass_model.mass(radius.0)
-                    * (1.0 + params.restitution)
-                    * hit.normal_speed,
-                normal_speed: hit.normal_speed,
-            });
-        }
+        wall_hits.write_batch(wall_collisions(ball, &contained, radius.0, &params));
     }
+}
+
+/// The [`WallCollision`]s of a containment: one per wall hit.
+pub fn wall_collisions(
+    ball: Entity,
+    contained: &Contained,
+    radius: f64,
+    params: &SimParams,
+) -> impl Iterator<Item = WallCollision> {
+    let (half, mass, restitution) = (
+        params.half_extents(),
+        params.mass_model.mass(radius),
+        params.restitution,
+    );
+    let position = contained.position;
+    contained
+        .hits
+        .into_iter()
+        .flatten()
+        .map(move |hit| WallCollision {
+            ball,
+            wall: hit.wall,
+            point: wall_contact_point(hit.wall, position, half),
+            impulse: mass * (1.0 + restitution) * hit.normal_speed,
+            normal_speed: hit.normal_speed,
+        })
 }
 
 #[cfg(test)]

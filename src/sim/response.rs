@@ -1,6 +1,6 @@
 //! Stage 3, response: for each contact, the elastic exchange along the line of centres, then
-//! separation so nothing sticks; finally the wall bounce again, since separation may push a
-//! ball into a wall.
+//! separation so nothing sticks; finally the walls again for the separated balls, since
+//! separation may push a ball into a wall.
 //!
 //! Runs in [`SimSystems::Response`](super::SimSystems::Response), reading [`Contacts`] in
 //! their stable order (Gauss–Seidel: each contact sees the velocities the earlier ones left).
@@ -14,17 +14,12 @@ use super::SimSystems;
 use super::ball::{Ball, Position, Velocity};
 use super::collision::narrow_phase::{Circle, circle_contact};
 use super::collision::{BallSnapshot, Contacts};
-use super::messages::BallCollision;
-use super::movement::bounce_off_walls;
+use super::messages::{BallCollision, WallCollision};
+use super::movement::{contain_in_arena, wall_collisions};
 use super::params::SimParams;
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(
-        FixedUpdate,
-        (resolve_contacts, bounce_off_walls)
-            .chain()
-            .in_set(SimSystems::Response),
-    );
+    app.add_systems(FixedUpdate, resolve_contacts.in_set(SimSystems::Response));
 }
 
 /// The result of [`normal_exchange`]: the new velocities and what the hit carried.
@@ -90,6 +85,7 @@ fn resolve_contacts(
     mut snapshot: ResMut<BallSnapshot>,
     mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
     mut collisions: MessageWriter<BallCollision>,
+    mut wall_hits: MessageWriter<WallCollision>,
 ) {
     if contacts.0.is_empty() {
         return;
@@ -129,6 +125,30 @@ fn resolve_contacts(
         let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
         circles[a].center -= geometry.normal * back;
         circles[b].center += geometry.normal * forward;
+    }
+    // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
+    // the movement stage kept every ball inside, so only they need the walls again.
+    let half = params.half_extents();
+    for index in contacts
+        .0
+        .iter()
+        .flat_map(|c| [c.index_a as usize, c.index_b as usize])
+    {
+        let circle = circles[index];
+        let contained = contain_in_arena(
+            circle.center,
+            velocities[index],
+            circle.radius,
+            half,
+            params.restitution,
+        );
+        (circles[index].center, velocities[index]) = (contained.position, contained.velocity);
+        wall_hits.write_batch(wall_collisions(
+            entities[index],
+            &contained,
+            circle.radius,
+            &params,
+        ));
     }
     write_back(entities, circles, velocities, &mut balls);
 }
