@@ -15,7 +15,7 @@ use super::{SimSystems, step_seconds};
 pub(super) fn plugin(app: &mut App) {
     app.add_systems(
         FixedUpdate,
-        (remember_positions, integrate_motion, bounce_off_walls)
+        (integrate_motion, bounce_off_walls)
             .chain()
             .in_set(SimSystems::Movement),
     );
@@ -109,27 +109,22 @@ pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
     }
 }
 
-fn remember_positions(mut balls: Query<(&Position, &mut PreviousPosition), With<Ball>>) {
-    balls
-        .par_iter_mut()
-        .for_each(|(position, mut previous)| previous.0 = position.0);
-}
-
+/// Remembers where each ball was (for drawing between steps), then integrates it.
 fn integrate_motion(
     time: Res<Time>,
     params: Res<SimParams>,
-    mut balls: Query<(&mut Position, &mut Velocity), With<Ball>>,
+    mut balls: Query<(&mut Position, &mut PreviousPosition, &mut Velocity), With<Ball>>,
 ) {
     let dt = step_seconds(&time, &params);
     let (gravity, damping) = (params.gravity, params.linear_damping);
     balls
         .par_iter_mut()
-        .for_each(|(mut position, mut velocity)| {
+        .for_each(|(mut position, mut previous, mut velocity)| {
+            previous.0 = position.0;
             (position.0, velocity.0) = integrate(position.0, velocity.0, gravity, damping, dt);
         });
 }
 
-/// Keeps every ball inside the arena, writing a [`WallCollision`] per bounce.
 fn bounce_off_walls(
     params: Res<SimParams>,
     mut balls: Query<(Entity, &mut Position, &mut Velocity, &Radius), With<Ball>>,
