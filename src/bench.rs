@@ -12,7 +12,7 @@ use std::time::Instant;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::headless::{DEFAULT_DT, headless_app_with_threads};
+use crate::headless::{DEFAULT_DT, headless_app_with_threads, median};
 use crate::sim::{BroadPhase, Contacts, SceneFile, SimParams};
 
 /// The standard gas, built in so the bench runs from any directory.
@@ -64,8 +64,7 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
         step_ms.push(started.elapsed().as_secs_f64() * 1e3);
         contacts += app.world().resource::<Contacts>().0.len();
     }
-    step_ms.sort_by(f64::total_cmp);
-    let median = step_ms.get(step_ms.len() / 2).copied().unwrap_or(0.0);
+    let median = median(&mut step_ms);
     Ok(CaseResult {
         case,
         cores: available_cores(),

@@ -142,7 +142,8 @@ pub fn run_scene_with_threads(
     (app, report)
 }
 
-fn median(values: &mut [f64]) -> f64 {
+/// The middle value (the mean of the two middle ones for an even count); zero for none.
+pub(crate) fn median(values: &mut [f64]) -> f64 {
     if values.is_empty() {
         return 0.0;
     }

@@ -5,7 +5,6 @@
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use serde::{Deserialize, Serialize};
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
@@ -39,7 +38,7 @@ impl Default for Radius {
 }
 
 /// One ball's state as plain values: what scene files describe and dumps record.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BallState {
     pub position: DVec2,
     pub velocity: DVec2,

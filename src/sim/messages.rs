@@ -4,7 +4,6 @@
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use serde::Serialize;
 
 /// Two balls that were approaching along their line of centres and exchanged momentum.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -22,7 +21,7 @@ pub struct BallCollision {
 }
 
 /// The four sides of the arena.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Wall {
     Left,
     Right,

@@ -103,8 +103,6 @@ pub struct StateSummary {
     pub max_overlap_rel: f64,
     /// Balls whose centre lies outside the arena.
     pub escaped: usize,
-    /// Balls whose position or velocity is not finite.
-    pub non_finite: usize,
 }
 
 impl StateSummary {
@@ -133,9 +131,6 @@ impl StateSummary {
             summary.momentum += velocity.0 * mass;
             if position.x.abs() > half.x || position.y.abs() > half.y {
                 summary.escaped += 1;
-            }
-            if !(position.is_finite() && velocity.is_finite()) {
-                summary.non_finite += 1;
             }
             circles.push(Circle::new(position.0, radius.0));
         }
