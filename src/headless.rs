@@ -5,6 +5,7 @@
 use std::time::{Duration, Instant};
 
 use bevy::app::{TaskPoolOptions, TaskPoolPlugin};
+use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
@@ -44,6 +45,11 @@ pub fn headless_app_with_threads(dt: f64, compute_threads: Option<usize>) -> App
         .resource_mut::<Time<Virtual>>()
         .set_max_delta(Duration::from_secs_f64(dt.max(0.25) * 2.0));
     app.update();
+    // The stages are chained and each uses the compute pool inside itself where that pays, so
+    // handing systems to other threads only adds wake-ups: run every schedule on this thread.
+    for (_, schedule) in app.world_mut().resource_mut::<Schedules>().iter_mut() {
+        schedule.set_executor(SingleThreadedExecutor::default());
+    }
     app
 }
 

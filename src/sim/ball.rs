@@ -6,6 +6,8 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use super::collision::narrow_phase::Circle;
+
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
 #[require(BallId, Position, PreviousPosition, Velocity, Radius)]
@@ -70,4 +72,15 @@ pub fn ball_bundle(
         Velocity(state.velocity),
         Radius(state.radius),
     )
+}
+
+/// Every ball after this step's movement, in query order, in contiguous arrays. The movement
+/// stage writes it as it moves the balls, the collision stage searches it and the response
+/// works on it by index before writing the balls it changed back to their components.
+#[derive(Resource, Debug, Default)]
+pub struct BallSnapshot {
+    pub entities: Vec<Entity>,
+    pub circles: Vec<Circle>,
+    /// Pixels per second.
+    pub velocities: Vec<DVec2>,
 }

@@ -24,6 +24,7 @@ pub mod scene;
 pub mod spawn;
 pub mod stats;
 
+use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 
 pub use ball::{Ball, BallId, BallState, Position, PreviousPosition, Radius, Velocity};
@@ -78,7 +79,12 @@ impl Plugin for SimPlugin {
             .add_systems(
                 FixedUpdate,
                 take_pending_step.in_set(SimSystems::Bookkeeping),
-            );
+            )
+            // The stages are chained, so no two of them could run at once; each uses the
+            // compute pool inside itself where that pays. One thread saves the wake-ups.
+            .edit_schedule(FixedUpdate, |schedule| {
+                schedule.set_executor(SingleThreadedExecutor::default());
+            });
     }
 }
 

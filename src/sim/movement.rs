@@ -7,18 +7,15 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{Ball, Position, PreviousPosition, Radius, Velocity};
+use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Velocity};
+use super::collision::narrow_phase::Circle;
 use super::messages::{Wall, WallCollision};
 use super::params::SimParams;
 use super::{SimSystems, step_seconds};
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(
-        FixedUpdate,
-        (integrate_motion, bounce_off_walls)
-            .chain()
-            .in_set(SimSystems::Movement),
-    );
+    app.init_resource::<BallSnapshot>()
+        .add_systems(FixedUpdate, move_balls.in_set(SimSystems::Movement));
 }
 
 /// A wall hit as plain values, before it becomes a [`WallCollision`].
@@ -38,17 +35,39 @@ pub struct Contained {
     pub hits: [Option<WallHit>; 2],
 }
 
-/// Semi-implicit Euler with gravity and exponential damping over `dt` seconds.
-#[inline]
-pub fn integrate(
-    position: DVec2,
-    velocity: DVec2,
-    gravity: DVec2,
-    damping: f64,
-    dt: f64,
-) -> (DVec2, DVec2) {
-    let velocity = (velocity + gravity * dt) * (-damping * dt).exp();
-    (position + velocity * dt, velocity)
+/// One step's motion: semi-implicit Euler with gravity and exponential damping over `dt`
+/// seconds. The constants are worked out once per step, not once per ball.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// Velocity gained from gravity over the step.
+    gravity_gain: DVec2,
+    /// Factor the velocity keeps after damping: `exp(-damping * dt)`.
+    decay: f64,
+    /// Seconds.
+    pub dt: f64,
+}
+
+impl Motion {
+    pub fn new(gravity: DVec2, damping: f64, dt: f64) -> Self {
+        Self {
+            gravity_gain: gravity * dt,
+            decay: (-damping * dt).exp(),
+            dt,
+        }
+    }
+
+    /// The velocity at the end of the step: gravity first, then damping.
+    #[inline]
+    pub fn velocity(&self, velocity: DVec2) -> DVec2 {
+        (velocity + self.gravity_gain) * self.decay
+    }
+
+    /// Position and velocity at the end of the step, moving at the new velocity.
+    #[inline]
+    pub fn integrate(&self, position: DVec2, velocity: DVec2) -> (DVec2, DVec2) {
+        let velocity = self.velocity(velocity);
+        (position + velocity * self.dt, velocity)
+    }
 }
 
 /// Puts a ball whose circle crosses a wall of the arena `[-half, half]` back inside.
@@ -109,36 +128,49 @@ pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
     }
 }
 
-/// Remembers where each ball was (for drawing between steps), then integrates it.
-fn integrate_motion(
+/// Remembers where each ball was (for drawing between steps), integrates it, keeps it in the
+/// arena and records it in the [`BallSnapshot`]: one pass over the balls.
+fn move_balls(
     time: Res<Time>,
     params: Res<SimParams>,
-    mut balls: Query<(&mut Position, &mut PreviousPosition, &mut Velocity), With<Ball>>,
-) {
-    let dt = step_seconds(&time, &params);
-    let (gravity, damping) = (params.gravity, params.linear_damping);
-    balls
-        .par_iter_mut()
-        .for_each(|(mut position, mut previous, mut velocity)| {
-            previous.0 = position.0;
-            (position.0, velocity.0) = integrate(position.0, velocity.0, gravity, damping, dt);
-        });
-}
-
-fn bounce_off_walls(
-    params: Res<SimParams>,
-    mut balls: Query<(Entity, &mut Position, &mut Velocity, &Radius), With<Ball>>,
+    mut balls: Query<
+        (
+            Entity,
+            &mut Position,
+            &mut PreviousPosition,
+            &mut Velocity,
+            &Radius,
+        ),
+        With<Ball>,
+    >,
     mut wall_hits: MessageWriter<WallCollision>,
+    mut snapshot: ResMut<BallSnapshot>,
 ) {
+    let BallSnapshot {
+        entities,
+        circles,
+        velocities,
+    } = &mut *snapshot;
+    entities.clear();
+    circles.clear();
+    velocities.clear();
+    let motion = Motion::new(
+        params.gravity,
+        params.linear_damping,
+        step_seconds(&time, &params),
+    );
     let half = params.half_extents();
-    for (ball, mut position, mut velocity, radius) in &mut balls {
-        let contained =
-            contain_in_arena(position.0, velocity.0, radius.0, half, params.restitution);
-        if contained.position == position.0 && contained.velocity == velocity.0 {
-            continue;
-        }
+    for (ball, mut position, mut previous, mut velocity, radius) in &mut balls {
+        previous.0 = position.0;
+        let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
+        let contained = contain_in_arena(moved, new_velocity, radius.0, half, params.restitution);
         (position.0, velocity.0) = (contained.position, contained.velocity);
-        wall_hits.write_batch(wall_collisions(ball, &contained, radius.0, &params));
+        if contained.hits != [None, None] {
+            wall_hits.write_batch(wall_collisions(ball, &contained, radius.0, &params));
+        }
+        entities.push(ball);
+        circles.push(Circle::new(position.0, radius.0));
+        velocities.push(velocity.0);
     }
 }
 
@@ -176,20 +208,15 @@ mod tests {
 
     #[test]
     fn integration_applies_gravity_before_moving() {
-        let (p, v) = integrate(
-            DVec2::ZERO,
-            DVec2::new(10.0, 0.0),
-            DVec2::new(0.0, -10.0),
-            0.0,
-            0.5,
-        );
+        let (p, v) = Motion::new(DVec2::new(0.0, -10.0), 0.0, 0.5)
+            .integrate(DVec2::ZERO, DVec2::new(10.0, 0.0));
         assert_eq!(v, DVec2::new(10.0, -5.0));
         assert_eq!(p, DVec2::new(5.0, -2.5));
     }
 
     #[test]
     fn damping_decays_velocity_exponentially() {
-        let (_, v) = integrate(DVec2::ZERO, DVec2::new(8.0, 0.0), DVec2::ZERO, 2.0, 0.5);
+        let v = Motion::new(DVec2::ZERO, 2.0, 0.5).velocity(DVec2::new(8.0, 0.0));
         assert!((v.x - 8.0 * (-1.0f64).exp()).abs() < 1e-12);
     }
 

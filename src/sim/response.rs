@@ -4,16 +4,16 @@
 //!
 //! Runs in [`SimSystems::Response`](super::SimSystems::Response), reading [`Contacts`] in
 //! their stable order (Gauss–Seidel: each contact sees the velocities the earlier ones left).
-//! Works on the collision stage's contiguous [`BallSnapshot`] by index, then writes the balls
-//! that changed back to their components in one pass. Writes a [`BallCollision`] per exchange.
+//! Works on the contiguous [`BallSnapshot`] by index, then writes the balls that changed back
+//! to their components in one pass. Writes a [`BallCollision`] per exchange.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::SimSystems;
-use super::ball::{Ball, Position, Velocity};
-use super::collision::narrow_phase::{Circle, circle_contact};
-use super::collision::{BallSnapshot, Contacts};
+use super::ball::{Ball, BallSnapshot, Position, Velocity};
+use super::collision::Contacts;
+use super::collision::narrow_phase::circle_contact;
 use super::messages::{BallCollision, WallCollision};
 use super::movement::{contain_in_arena, wall_collisions};
 use super::params::SimParams;
@@ -86,6 +86,7 @@ fn resolve_contacts(
     mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
     mut collisions: MessageWriter<BallCollision>,
     mut wall_hits: MessageWriter<WallCollision>,
+    mut in_contact: Local<Vec<bool>>,
 ) {
     if contacts.0.is_empty() {
         return;
@@ -95,8 +96,11 @@ fn resolve_contacts(
         circles,
         velocities,
     } = &mut *snapshot;
+    in_contact.clear();
+    in_contact.resize(entities.len(), false);
     for contact in &contacts.0 {
         let (a, b) = (contact.index_a as usize, contact.index_b as usize);
+        (in_contact[a], in_contact[b]) = (true, true);
         // Earlier contacts may have moved either ball: work from where they are now.
         let Some(geometry) = circle_contact(circles[a], circles[b]) else {
             continue;
@@ -127,13 +131,10 @@ fn resolve_contacts(
         circles[b].center += geometry.normal * forward;
     }
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
-    // the movement stage kept every ball inside, so only they need the walls again.
+    // the movement stage kept every ball inside, so only they need the walls again, and only
+    // they are written back.
     let half = params.half_extents();
-    for index in contacts
-        .0
-        .iter()
-        .flat_map(|c| [c.index_a as usize, c.index_b as usize])
-    {
+    let mut settle = |index: usize| {
         let circle = circles[index];
         let contained = contain_in_arena(
             circle.center,
@@ -142,41 +143,31 @@ fn resolve_contacts(
             half,
             params.restitution,
         );
-        (circles[index].center, velocities[index]) = (contained.position, contained.velocity);
-        wall_hits.write_batch(wall_collisions(
-            entities[index],
-            &contained,
-            circle.radius,
-            &params,
-        ));
-    }
-    write_back(entities, circles, velocities, &mut balls);
-}
-
-/// Copies the snapshot's positions and velocities back to the components, touching only the
-/// balls that changed. The query visits the balls in the snapshot's order (nothing spawns or
-/// despawns within a step); a ball out of step is looked up by entity instead.
-fn write_back(
-    entities: &[Entity],
-    circles: &[Circle],
-    velocities: &[DVec2],
-    balls: &mut Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
-) {
-    let mut in_order = true;
+        if contained.hits != [None, None] {
+            wall_hits.write_batch(wall_collisions(
+                entities[index],
+                &contained,
+                circle.radius,
+                &params,
+            ));
+        }
+        (contained.position, contained.velocity)
+    };
+    // The query visits the balls in the snapshot's order (nothing spawns or despawns within a
+    // step); should that ever not hold, the rest are looked up by entity.
+    let mut matched = 0;
     for (index, (entity, mut position, mut velocity)) in balls.iter_mut().enumerate() {
         if entities.get(index) != Some(&entity) {
-            in_order = false;
             break;
         }
-        position.set_if_neq(Position(circles[index].center));
-        velocity.set_if_neq(Velocity(velocities[index]));
+        matched = index + 1;
+        if in_contact[index] {
+            (position.0, velocity.0) = settle(index);
+        }
     }
-    if !in_order {
-        for (index, &entity) in entities.iter().enumerate() {
-            if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity) {
-                position.set_if_neq(Position(circles[index].center));
-                velocity.set_if_neq(Velocity(velocities[index]));
-            }
+    for index in (matched..entities.len()).filter(|&index| in_contact[index]) {
+        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entities[index]) {
+            (position.0, velocity.0) = settle(index);
         }
     }
 }

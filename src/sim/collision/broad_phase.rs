@@ -75,14 +75,19 @@ impl UniformGrid {
         }
         self.cell_start[cell_count] = circles.len() as u32;
         self.sorted_index.resize(circles.len(), 0);
-        self.sorted_circle
-            .resize(circles.len(), Circle::new(DVec2::ZERO, 0.0));
-        for (index, (&cell, circle)) in self.cell_of.iter().zip(circles).enumerate().rev() {
+        for (index, &cell) in self.cell_of.iter().enumerate().rev() {
             let slot = &mut self.cell_start[cell as usize];
             *slot -= 1;
             self.sorted_index[*slot as usize] = index as u32;
-            self.sorted_circle[*slot as usize] = *circle;
         }
+        // Scatter only the indices, then gather the circles: independent random reads overlap
+        // in the memory system far better than random writes of whole circles.
+        self.sorted_circle.clear();
+        self.sorted_circle.extend(
+            self.sorted_index
+                .iter()
+                .map(|&index| circles[index as usize]),
+        );
     }
 
     /// Rows of cells: the unit [`for_each_candidate_pair_in_rows`](Self::for_each_candidate_pair_in_rows)
@@ -131,13 +136,14 @@ impl UniformGrid {
                 };
                 for slot in start..end {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-                    for other in (slot + 1..same_row_end).chain(above.clone()) {
-                        visit(
-                            index,
-                            self.sorted_index[other],
-                            circle,
-                            self.sorted_circle[other],
-                        );
+                    // Two plain loops over slices: no bounds checks and no chained iterator.
+                    for range in [slot + 1..same_row_end, above.clone()] {
+                        let others = self.sorted_index[range.clone()]
+                            .iter()
+                            .zip(&self.sorted_circle[range]);
+                        for (&other_index, &other) in others {
+                            visit(index, other_index, circle, other);
+                        }
                     }
                 }
             }

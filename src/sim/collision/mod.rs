@@ -1,9 +1,9 @@
 //! Stage 2, collision: find every touching pair and record it as a [`Contact`].
 //!
 //! Runs in [`SimSystems::Collision`](super::SimSystems::Collision), after movement and before
-//! response. Copies every ball into the contiguous [`BallSnapshot`]; the broad phase proposes
-//! candidate pairs, the narrow phase's AABB test and exact squared-distance test keep the
-//! touching ones. Writes [`Contacts`] and the snapshot; changes no ball.
+//! response, on the contiguous [`BallSnapshot`] the movement stage wrote: the broad phase
+//! proposes candidate pairs, the narrow phase's AABB test and exact squared-distance test keep
+//! the touching ones. Writes [`Contacts`]; changes no ball.
 
 pub mod broad_phase;
 pub mod narrow_phase;
@@ -13,7 +13,7 @@ use bevy::prelude::*;
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 use super::SimSystems;
-use super::ball::{Ball, Position, Radius, Velocity};
+use super::ball::BallSnapshot;
 use super::params::{BroadPhase, SimParams};
 use broad_phase::{UniformGrid, for_each_pair};
 use narrow_phase::{Circle, ContactGeometry, circle_contact, circles_touch};
@@ -21,7 +21,6 @@ use narrow_phase::{Circle, ContactGeometry, circle_contact, circles_touch};
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Contacts>()
         .init_resource::<CollisionScratch>()
-        .init_resource::<BallSnapshot>()
         .add_systems(FixedUpdate, detect_contacts.in_set(SimSystems::Collision));
 }
 
@@ -44,16 +43,6 @@ pub struct Contact {
 /// This step's contacts, in a stable order: the response processes them in this order.
 #[derive(Resource, Debug, Default)]
 pub struct Contacts(pub Vec<Contact>);
-
-/// Every ball as the collision stage found it, in query order, in contiguous arrays: what the
-/// response works on by index before writing the results back to the components.
-#[derive(Resource, Debug, Default)]
-pub struct BallSnapshot {
-    pub entities: Vec<Entity>,
-    pub circles: Vec<Circle>,
-    /// Pixels per second.
-    pub velocities: Vec<DVec2>,
-}
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -130,32 +119,18 @@ struct CollisionScratch {
 }
 
 fn detect_contacts(
-    balls: Query<(Entity, &Position, &Velocity, &Radius), With<Ball>>,
     params: Res<SimParams>,
+    snapshot: Res<BallSnapshot>,
     mut scratch: ResMut<CollisionScratch>,
-    mut snapshot: ResMut<BallSnapshot>,
     mut contacts: ResMut<Contacts>,
 ) {
     let CollisionScratch { grid, found } = &mut *scratch;
-    let BallSnapshot {
-        entities,
-        circles,
-        velocities,
-    } = &mut *snapshot;
-    entities.clear();
-    circles.clear();
-    velocities.clear();
-    for (entity, position, velocity, radius) in &balls {
-        entities.push(entity);
-        circles.push(Circle::new(position.0, radius.0));
-        velocities.push(velocity.0);
-    }
     found.clear();
-    find_contacts(circles, params.broad_phase, grid, found);
+    find_contacts(&snapshot.circles, params.broad_phase, grid, found);
     contacts.0.clear();
     contacts.0.extend(found.iter().map(|contact| Contact {
-        a: entities[contact.a as usize],
-        b: entities[contact.b as usize],
+        a: snapshot.entities[contact.a as usize],
+        b: snapshot.entities[contact.b as usize],
         index_a: contact.a,
         index_b: contact.b,
         normal: contact.geometry.normal,
