@@ -22,8 +22,8 @@ pub mod ui;
 pub mod prelude {
     pub use crate::headless::{RunReport, headless_app, run_scene};
     pub use crate::sim::{
-        Ball, BallCollision, BallId, BallState, BroadPhase, MassModel, Position, Radius, SceneFile,
-        SceneSetup, SimParams, SimPlugin, SimStats, SimSystems, StateSummary, Velocity, Wall,
-        WallCollision,
+        Ball, BallCollision, BallId, BallState, BroadPhase, CollisionMode, MassModel, Position,
+        Radius, SceneFile, SceneSetup, SimParams, SimPlugin, SimStats, SimSystems, StateSummary,
+        Velocity, Wall, WallCollision,
     };
 }

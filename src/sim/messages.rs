@@ -10,7 +10,10 @@ use bevy::prelude::*;
 pub struct BallCollision {
     pub a: Entity,
     pub b: Entity,
-    /// Radius-weighted collision point, pixels.
+    /// Simulated seconds since the scene was loaded: the exact moment of impact in continuous
+    /// mode, the end of the step in discrete mode (which only sees the overlap afterwards).
+    pub time: f64,
+    /// Radius-weighted collision point, pixels: where the balls touch in continuous mode.
     pub point: DVec2,
     /// Unit vector from `a` towards `b`.
     pub normal: DVec2,
@@ -46,6 +49,8 @@ impl Wall {
 pub struct WallCollision {
     pub ball: Entity,
     pub wall: Wall,
+    /// Simulated seconds since the scene was loaded, as in [`BallCollision::time`].
+    pub time: f64,
     /// Where the ball touched the wall, pixels.
     pub point: DVec2,
     /// Magnitude of the wall's impulse on the ball, mass x pixels per second.

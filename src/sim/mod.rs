@@ -15,6 +15,7 @@
 pub mod aim;
 pub mod ball;
 pub mod collision;
+pub mod continuous;
 pub mod messages;
 pub mod movement;
 pub mod params;
@@ -30,7 +31,7 @@ use bevy::prelude::*;
 pub use ball::{Ball, BallId, BallState, Position, PreviousPosition, Radius, Velocity};
 pub use collision::{Contact, Contacts};
 pub use messages::{BallCollision, Wall, WallCollision};
-pub use params::{BroadPhase, MassModel, SimParams};
+pub use params::{BroadPhase, CollisionMode, MassModel, SimParams};
 pub use scene::{SceneError, SceneFile, SceneSetup, SimRng};
 pub use spawn::SpawnSettings;
 pub use stats::{SimStats, StateSummary};
@@ -71,6 +72,7 @@ impl Plugin for SimPlugin {
             .add_plugins((
                 movement::plugin,
                 collision::plugin,
+                continuous::plugin,
                 response::plugin,
                 stats::plugin,
                 scene::plugin,

@@ -10,7 +10,8 @@ use bevy::prelude::*;
 use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Velocity};
 use super::collision::narrow_phase::Circle;
 use super::messages::{Wall, WallCollision};
-use super::params::SimParams;
+use super::params::{CollisionMode, SimParams};
+use super::stats::SimStats;
 use super::{SimSystems, step_seconds};
 
 pub(super) fn plugin(app: &mut App) {
@@ -129,7 +130,8 @@ pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
 }
 
 /// Remembers where each ball was (for drawing between steps), integrates it, keeps it in the
-/// arena and records it in the [`BallSnapshot`]: one pass over the balls.
+/// arena and records it in the [`BallSnapshot`]: one pass over the balls. In continuous mode
+/// only the velocity changes here; the response stage's timeline moves the balls.
 fn move_balls(
     time: Res<Time>,
     params: Res<SimParams>,
@@ -143,6 +145,7 @@ fn move_balls(
         ),
         With<Ball>,
     >,
+    stats: Res<SimStats>,
     mut wall_hits: MessageWriter<WallCollision>,
     mut snapshot: ResMut<BallSnapshot>,
 ) {
@@ -160,13 +163,23 @@ fn move_balls(
         step_seconds(&time, &params),
     );
     let half = params.half_extents();
+    let step_end = stats.sim_time + motion.dt;
+    let continuous = params.collisions == CollisionMode::Continuous;
     for (ball, mut position, mut previous, mut velocity, radius) in &mut balls {
         previous.0 = position.0;
-        let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
-        let contained = contain_in_arena(moved, new_velocity, radius.0, half, params.restitution);
-        (position.0, velocity.0) = (contained.position, contained.velocity);
-        if contained.hits != [None, None] {
-            wall_hits.write_batch(wall_collisions(ball, &contained, radius.0, &params));
+        if continuous {
+            // The timeline moves the balls, impact by impact.
+            velocity.0 = motion.velocity(velocity.0);
+        } else {
+            let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
+            let contained =
+                contain_in_arena(moved, new_velocity, radius.0, half, params.restitution);
+            (position.0, velocity.0) = (contained.position, contained.velocity);
+            if contained.hits != [None, None] {
+                wall_hits.write_batch(wall_collisions(
+                    ball, &contained, radius.0, &params, step_end,
+                ));
+            }
         }
         entities.push(ball);
         circles.push(Circle::new(position.0, radius.0));
@@ -180,6 +193,7 @@ pub fn wall_collisions(
     contained: &Contained,
     radius: f64,
     params: &SimParams,
+    time: f64,
 ) -> impl Iterator<Item = WallCollision> {
     let (half, mass, restitution) = (
         params.half_extents(),
@@ -194,6 +208,7 @@ pub fn wall_collisions(
         .map(move |hit| WallCollision {
             ball,
             wall: hit.wall,
+            time,
             point: wall_contact_point(hit.wall, position, half),
             impulse: mass * (1.0 + restitution) * hit.normal_speed,
             normal_speed: hit.normal_speed,

@@ -69,6 +69,23 @@ pub enum BroadPhase {
     AllPairs,
 }
 
+/// How a step finds and treats collisions.
+#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CollisionMode {
+    /// Each step is a timeline: every impact (ball or wall) is found at its exact time of
+    /// impact and handled in time order, so nothing tunnels or overlaps and, with restitution
+    /// 1, energy is kept. The default: the toy's flings reach several diameters a step.
+    #[default]
+    Continuous,
+    /// The tutorial's method: move every ball, find the pairs that overlap, exchange momentum
+    /// and push them apart. Fast balls can pass through each other.
+    Discrete,
+}
+
+impl CollisionMode {
+    pub const ALL: [CollisionMode; 2] = [CollisionMode::Continuous, CollisionMode::Discrete];
+}
+
 /// The simulation's tunables.
 #[derive(Resource, Reflect, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[reflect(Resource)]
@@ -86,6 +103,7 @@ pub struct SimParams {
     pub time_scale: f64,
     /// While paused the fixed-step stages do not run.
     pub paused: bool,
+    pub collisions: CollisionMode,
     pub broad_phase: BroadPhase,
 }
 
@@ -99,6 +117,7 @@ impl Default for SimParams {
             linear_damping: 0.0,
             time_scale: 1.0,
             paused: false,
+            collisions: CollisionMode::Continuous,
             broad_phase: BroadPhase::Grid,
         }
     }

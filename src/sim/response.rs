@@ -10,16 +10,23 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::SimSystems;
 use super::ball::{Ball, BallSnapshot, Position, Velocity};
 use super::collision::Contacts;
-use super::collision::narrow_phase::circle_contact;
+use super::collision::narrow_phase::{Circle, ContactGeometry, circle_contact};
+use super::continuous::in_mode;
 use super::messages::{BallCollision, WallCollision};
 use super::movement::{contain_in_arena, wall_collisions};
-use super::params::SimParams;
+use super::params::{CollisionMode, MassModel, SimParams};
+use super::stats::SimStats;
+use super::{SimSystems, step_seconds};
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(FixedUpdate, resolve_contacts.in_set(SimSystems::Response));
+    app.add_systems(
+        FixedUpdate,
+        resolve_contacts
+            .in_set(SimSystems::Response)
+            .run_if(in_mode(CollisionMode::Discrete)),
+    );
 }
 
 /// The result of [`normal_exchange`]: the new velocities and what the hit carried.
@@ -79,7 +86,47 @@ pub fn separation_shares(depth: f64, inverse_mass_a: f64, inverse_mass_b: f64) -
     )
 }
 
+/// The discrete response on plain arrays: for each pair `(a, b)` of indices, in order, that
+/// still touches where the earlier pairs left it, the exchange along the normal (if the balls
+/// approach; `on_exchange` hears of it) and then separation shared by inverse mass. Both
+/// collision modes use it: discrete for every contact, continuous for a step it cut short.
+pub fn resolve_overlaps(
+    pairs: impl IntoIterator<Item = (u32, u32)>,
+    circles: &mut [Circle],
+    velocities: &mut [DVec2],
+    mass_model: MassModel,
+    restitution: f64,
+    mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
+) {
+    for (a, b) in pairs {
+        let (ia, ib) = (a as usize, b as usize);
+        // Earlier pairs may have moved either ball: work from where they are now.
+        let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
+            continue;
+        };
+        let inverse_mass_a = mass_model.inverse_mass(circles[ia].radius);
+        let inverse_mass_b = mass_model.inverse_mass(circles[ib].radius);
+        if let Some(exchange) = normal_exchange(
+            velocities[ia],
+            velocities[ib],
+            inverse_mass_a,
+            inverse_mass_b,
+            geometry.normal,
+            restitution,
+        ) {
+            velocities[ia] = exchange.velocity_a;
+            velocities[ib] = exchange.velocity_b;
+            on_exchange(a, b, geometry, exchange);
+        }
+        let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
+        circles[ia].center -= geometry.normal * back;
+        circles[ib].center += geometry.normal * forward;
+    }
+}
+
 fn resolve_contacts(
+    time: Res<Time>,
+    stats: Res<SimStats>,
     contacts: Res<Contacts>,
     params: Res<SimParams>,
     mut snapshot: ResMut<BallSnapshot>,
@@ -91,6 +138,8 @@ fn resolve_contacts(
     if contacts.0.is_empty() {
         return;
     }
+    // Discrete mode sees a hit only at the end of the step, as an overlap.
+    let step_end = stats.sim_time + step_seconds(&time, &params);
     let BallSnapshot {
         entities,
         circles,
@@ -99,37 +148,31 @@ fn resolve_contacts(
     in_contact.clear();
     in_contact.resize(entities.len(), false);
     for contact in &contacts.0 {
-        let (a, b) = (contact.index_a as usize, contact.index_b as usize);
-        (in_contact[a], in_contact[b]) = (true, true);
-        // Earlier contacts may have moved either ball: work from where they are now.
-        let Some(geometry) = circle_contact(circles[a], circles[b]) else {
-            continue;
-        };
-        let inverse_mass_a = params.mass_model.inverse_mass(circles[a].radius);
-        let inverse_mass_b = params.mass_model.inverse_mass(circles[b].radius);
-        if let Some(exchange) = normal_exchange(
-            velocities[a],
-            velocities[b],
-            inverse_mass_a,
-            inverse_mass_b,
-            geometry.normal,
-            params.restitution,
-        ) {
-            velocities[a] = exchange.velocity_a;
-            velocities[b] = exchange.velocity_b;
+        (
+            in_contact[contact.index_a as usize],
+            in_contact[contact.index_b as usize],
+        ) = (true, true);
+    }
+    let pairs = contacts.0.iter().map(|c| (c.index_a, c.index_b));
+    let (mass_model, restitution) = (params.mass_model, params.restitution);
+    resolve_overlaps(
+        pairs,
+        circles,
+        velocities,
+        mass_model,
+        restitution,
+        |a, b, geometry, exchange| {
             collisions.write(BallCollision {
-                a: contact.a,
-                b: contact.b,
+                a: entities[a as usize],
+                b: entities[b as usize],
+                time: step_end,
                 point: geometry.point,
                 normal: geometry.normal,
                 impulse: exchange.impulse,
                 normal_speed: exchange.closing_speed,
             });
-        }
-        let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
-        circles[a].center -= geometry.normal * back;
-        circles[b].center += geometry.normal * forward;
-    }
+        },
+    );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
     // the movement stage kept every ball inside, so only they need the walls again, and only
     // they are written back.
@@ -149,25 +192,40 @@ fn resolve_contacts(
                 &contained,
                 circle.radius,
                 &params,
+                step_end,
             ));
         }
         (contained.position, contained.velocity)
     };
-    // The query visits the balls in the snapshot's order (nothing spawns or despawns within a
-    // step); should that ever not hold, the rest are looked up by entity.
+    write_back(entities, &mut balls, |index| {
+        in_contact[index].then(|| settle(index))
+    });
+}
+
+/// Writes each ball's new `(position, velocity)` from `new_state(index)`, where `index` is
+/// its place in the snapshot's `entities`; `None` leaves the ball as it is. The query visits
+/// the balls in the snapshot's order (nothing spawns or despawns within a step); should that
+/// ever not hold, the rest are looked up by entity.
+pub(super) fn write_back(
+    entities: &[Entity],
+    balls: &mut Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut new_state: impl FnMut(usize) -> Option<(DVec2, DVec2)>,
+) {
     let mut matched = 0;
     for (index, (entity, mut position, mut velocity)) in balls.iter_mut().enumerate() {
         if entities.get(index) != Some(&entity) {
             break;
         }
         matched = index + 1;
-        if in_contact[index] {
-            (position.0, velocity.0) = settle(index);
+        if let Some(state) = new_state(index) {
+            (position.0, velocity.0) = state;
         }
     }
-    for index in (matched..entities.len()).filter(|&index| in_contact[index]) {
-        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entities[index]) {
-            (position.0, velocity.0) = settle(index);
+    for (index, &entity) in entities.iter().enumerate().skip(matched) {
+        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity)
+            && let Some(state) = new_state(index)
+        {
+            (position.0, velocity.0) = state;
         }
     }
 }

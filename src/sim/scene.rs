@@ -8,6 +8,7 @@
 //! (
 //!   arena: (width: 800.0, height: 600.0),        // centred on the origin, x right, y up
 //!   gravity: (0.0, 0.0), restitution: 1.0, mass_model: Radius,   // optional
+//!   collisions: Continuous,                        // optional: or Discrete
 //!   balls: [ (position: (-100.0, 0.0), velocity: (5.0, 0.0), radius: 10.0) ],  // optional
 //!   generate: Some((count: 1000, radius: (5.0, 15.0), speed: (0.0, 500.0),
 //!                   area_fraction: 0.30, seed: 1)),   // optional
@@ -26,8 +27,8 @@ use serde::{Deserialize, Serialize};
 use super::ball::{Ball, BallState, NextBallId, ball_bundle};
 use super::collision::narrow_phase::Circle;
 use super::params::{
-    ARENA_SIDE_RANGE, DAMPING_RANGE, MAX_BALLS, MAX_GRAVITY, MAX_SPEED, MassModel, RADIUS_RANGE,
-    RESTITUTION_RANGE, SimParams,
+    ARENA_SIDE_RANGE, CollisionMode, DAMPING_RANGE, MAX_BALLS, MAX_GRAVITY, MAX_SPEED, MassModel,
+    RADIUS_RANGE, RESTITUTION_RANGE, SimParams,
 };
 use super::placement::PlacementGrid;
 use super::stats::SimStats;
@@ -72,6 +73,9 @@ pub struct SceneFile {
     /// Per second.
     #[serde(default)]
     pub linear_damping: f64,
+    /// `Continuous` or `Discrete`; when absent, loading the scene keeps the mode in use.
+    #[serde(default)]
+    pub collisions: Option<CollisionMode>,
     /// Balls placed by hand.
     #[serde(default)]
     pub balls: Vec<BallSpec>,
@@ -143,6 +147,8 @@ pub enum SceneError {
 pub struct SceneSetup {
     /// The arena and physics the scene sets; the rest keep their defaults.
     pub params: SimParams,
+    /// The collision mode, if the scene sets one.
+    pub collisions: Option<CollisionMode>,
     pub balls: Vec<BallState>,
     /// The random stream after generation, for anything that draws later.
     pub rng: ChaCha8Rng,
@@ -215,6 +221,7 @@ impl SceneFile {
                 arena_size,
                 ..params
             },
+            collisions: self.collisions,
             balls,
             rng,
         })
@@ -453,6 +460,9 @@ impl SceneSetup {
         params.restitution = self.params.restitution;
         params.mass_model = self.params.mass_model;
         params.linear_damping = self.params.linear_damping;
+        if let Some(mode) = self.collisions {
+            params.collisions = mode;
+        }
         world.insert_resource(params);
         world.insert_resource(SimRng(self.rng.clone()));
         world.insert_resource(SimStats::default());

@@ -36,6 +36,9 @@ pub struct SimStats {
     pub wall_collisions: u64,
     /// Sum of the walls' normal impulses on the balls, mass x pixels per second.
     pub wall_impulse: f64,
+    /// Continuous steps that reached their hit budget and finished without handling every
+    /// impact (see [`MAX_HITS_PER_BALL`](super::continuous::MAX_HITS_PER_BALL)).
+    pub cut_short_steps: u64,
 }
 
 impl SimStats {

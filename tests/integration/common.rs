@@ -12,6 +12,7 @@ pub fn app_with(params: SimParams, balls: &[BallState]) -> App {
     let mut app = headless_app(DT);
     let setup = SceneSetup {
         params: params.clone(),
+        collisions: Some(params.collisions),
         balls: balls.to_vec(),
         rng: ballpit::sim::SimRng::default().0,
     };

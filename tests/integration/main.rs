@@ -3,6 +3,7 @@
 
 mod cli;
 mod common;
+mod continuous;
 mod game;
 mod physics;
 mod scenes;

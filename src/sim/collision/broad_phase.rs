@@ -90,6 +90,15 @@ impl UniformGrid {
         );
     }
 
+    /// Number of balls sorted in.
+    pub fn len(&self) -> usize {
+        self.sorted_index.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.sorted_index.is_empty()
+    }
+
     /// Rows of cells: the unit [`for_each_candidate_pair_in_rows`](Self::for_each_candidate_pair_in_rows)
     /// splits work by.
     pub fn rows(&self) -> usize {
@@ -150,12 +159,55 @@ impl UniformGrid {
         }
     }
 
-    fn cell_index(&self, center: DVec2) -> usize {
+    /// Number of cells: [`cell_index`](Self::cell_index) is below it.
+    pub fn cell_count(&self) -> usize {
+        self.columns * self.rows
+    }
+
+    /// The cell holding `point`. A point outside the grid goes to the nearest border cell, so
+    /// the cell order along each axis never contradicts the points' order.
+    pub fn cell_index(&self, point: DVec2) -> usize {
+        let (column, row) = self.cell_coordinates(point);
+        row * self.columns + column
+    }
+
+    fn cell_coordinates(&self, point: DVec2) -> (usize, usize) {
         // `as usize` saturates (and maps NaN to 0), so a stray value cannot index out of range.
-        let cell = (center - self.origin) * self.inverse_cell_size;
+        let cell = (point - self.origin) * self.inverse_cell_size;
         let column = (cell.x as usize).min(self.columns - 1);
         let row = (cell.y as usize).min(self.rows - 1);
-        row * self.columns + column
+        (column, row)
+    }
+
+    /// Calls `visit(cells)` with runs of consecutive cell indices that together cover every
+    /// cell overlapping the box `[min, max]`: one run per row.
+    pub fn for_each_cell_run_in_box(
+        &self,
+        min: DVec2,
+        max: DVec2,
+        mut visit: impl FnMut(std::ops::Range<usize>),
+    ) {
+        let (first_column, first_row) = self.cell_coordinates(min);
+        let (last_column, last_row) = self.cell_coordinates(max);
+        for row in first_row..=last_row {
+            let start = row * self.columns;
+            visit(start + first_column..start + last_column + 1);
+        }
+    }
+
+    /// Calls `visit(index, circle)` for every ball whose centre lies in the box `[min, max]`,
+    /// and for some just outside it (the rest of their cells). Indices are as in
+    /// [`for_each_candidate_pair`](Self::for_each_candidate_pair).
+    pub fn for_each_near(&self, min: DVec2, max: DVec2, mut visit: impl FnMut(u32, Circle)) {
+        self.for_each_cell_run_in_box(min, max, |cells| {
+            let slots = self.cell_start[cells.start] as usize..self.cell_start[cells.end] as usize;
+            for (&index, &circle) in self.sorted_index[slots.clone()]
+                .iter()
+                .zip(&self.sorted_circle[slots])
+            {
+                visit(index, circle);
+            }
+        });
     }
 }
 
@@ -227,5 +279,36 @@ mod tests {
         let mut grid = UniformGrid::default();
         grid.rebuild(&circles);
         assert!(grid.columns * grid.rows <= 2 * MAX_CELLS_PER_BALL + 4);
+    }
+
+    #[test]
+    fn a_box_query_finds_every_centre_inside_it() {
+        let circles: Vec<Circle> = (0..400)
+            .map(|i| {
+                let (x, y) = ((i * 37 % 101) as f64 * 3.3, (i * 61 % 97) as f64 * 2.9);
+                Circle::new(DVec2::new(x, y), 1.0 + (i % 5) as f64)
+            })
+            .collect();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        // Boxes inside, across and wholly outside the grid's extent.
+        for (min, max) in [
+            (DVec2::new(50.0, 40.0), DVec2::new(120.0, 90.0)),
+            (DVec2::new(-500.0, 200.0), DVec2::new(30.0, 1_000.0)),
+            (DVec2::new(400.0, 400.0), DVec2::new(900.0, 900.0)),
+        ] {
+            let mut visited = std::collections::HashSet::new();
+            grid.for_each_near(min, max, |index, circle| {
+                assert_eq!(circle, circles[index as usize]);
+                assert!(visited.insert(index), "ball {index} visited twice");
+            });
+            for (index, circle) in circles.iter().enumerate() {
+                let inside = circle.center.cmpge(min).all() && circle.center.cmple(max).all();
+                assert!(
+                    !inside || visited.contains(&(index as u32)),
+                    "missed {index}"
+                );
+            }
+        }
     }
 }

@@ -8,23 +8,33 @@
 pub mod broad_phase;
 pub mod narrow_phase;
 
+use std::ops::Range;
+
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 use super::SimSystems;
 use super::ball::BallSnapshot;
-use super::params::{BroadPhase, SimParams};
+use super::continuous::in_mode;
+use super::params::{BroadPhase, CollisionMode, SimParams};
 use broad_phase::{UniformGrid, for_each_pair};
 use narrow_phase::{Circle, ContactGeometry, circle_contact, circles_touch};
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Contacts>()
         .init_resource::<CollisionScratch>()
-        .add_systems(FixedUpdate, detect_contacts.in_set(SimSystems::Collision));
+        .add_systems(
+            FixedUpdate,
+            detect_contacts
+                .in_set(SimSystems::Collision)
+                .run_if(in_mode(CollisionMode::Discrete)),
+        );
 }
 
-/// Two balls that touch or overlap after this step's movement.
+/// Two balls in contact this step. In discrete mode: a pair touching or overlapping after
+/// the movement, found by the collision stage. In continuous mode: a pair at its moment of
+/// impact (depth zero), recorded by the response stage as it handles the impact.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
     pub a: Entity,
@@ -40,7 +50,8 @@ pub struct Contact {
     pub point: DVec2,
 }
 
-/// This step's contacts, in a stable order: the response processes them in this order.
+/// This step's contacts, in a stable order: in discrete mode the response processes them in
+/// this order; in continuous mode they are the impacts in the order handled.
 #[derive(Resource, Debug, Default)]
 pub struct Contacts(pub Vec<Contact>);
 
@@ -70,28 +81,41 @@ pub fn find_contacts(
     match method {
         BroadPhase::Grid => {
             grid.rebuild(circles);
-            if circles.len() < PARALLEL_MIN_BALLS {
-                grid.for_each_candidate_pair(keep_touching(found));
-                return;
-            }
-            let pool = ComputeTaskPool::get_or_init(TaskPool::default);
-            let band_count = (pool.thread_num() * BANDS_PER_THREAD).max(1);
-            let rows = grid.rows();
-            let grid = &*grid;
-            let bands: Vec<Vec<IndexedContact>> = pool.scope(|scope| {
-                for band in 0..band_count {
-                    let band_rows = rows * band / band_count..rows * (band + 1) / band_count;
-                    scope.spawn(async move {
-                        let mut local = Vec::new();
-                        grid.for_each_candidate_pair_in_rows(band_rows, keep_touching(&mut local));
-                        local
-                    });
-                }
+            search_in_bands(grid, found, |grid, rows, local| {
+                grid.for_each_candidate_pair_in_rows(rows, keep_touching(local));
             });
-            found.extend(bands.into_iter().flatten());
         }
         BroadPhase::AllPairs => for_each_pair(circles, keep_touching(found)),
     }
+}
+
+/// Runs `search(grid, rows, out)` over bands of the grid's rows and appends what the bands
+/// find to `found` in row order, so the result does not depend on the thread count. The bands
+/// run in parallel on the compute pool once the grid holds [`PARALLEL_MIN_BALLS`] balls.
+pub fn search_in_bands<T: Send + 'static>(
+    grid: &UniformGrid,
+    found: &mut Vec<T>,
+    search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
+) {
+    let rows = grid.rows();
+    if grid.len() < PARALLEL_MIN_BALLS {
+        search(grid, 0..rows, found);
+        return;
+    }
+    let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+    let band_count = (pool.thread_num() * BANDS_PER_THREAD).max(1);
+    let search = &search;
+    let bands: Vec<Vec<T>> = pool.scope(|scope| {
+        for band in 0..band_count {
+            let band_rows = rows * band / band_count..rows * (band + 1) / band_count;
+            scope.spawn(async move {
+                let mut local = Vec::new();
+                search(grid, band_rows, &mut local);
+                local
+            });
+        }
+    });
+    found.extend(bands.into_iter().flatten());
 }
 
 /// A visitor for the broad phase that runs the narrow phase and keeps touching pairs.

@@ -1,0 +1,759 @@
+//! Continuous collisions: each fixed step as a timeline of impacts, handled in time order.
+//!
+//! In continuous mode the movement stage only updates velocities (gravity, damping), so every
+//! ball's path over the step is a straight segment. Then:
+//!
+//! - **Collision** ([`predict_impacts`], in [`SimSystems::Collision`]): the circles swept
+//!   along those segments go into the grid; their AABBs and distances cut the candidate
+//!   pairs, and the exact quadratic ([`time_of_impact`]) gives each approaching pair's moment
+//!   of contact. Each ball's first wall contact is found the same way.
+//! - **Response** ([`run_timeline`], in [`SimSystems::Response`]): take the earliest impact,
+//!   move just its balls to that moment, exchange momentum along the line of centres (or
+//!   reflect off the wall), predict anew for those balls, and repeat until the step is over;
+//!   then move every ball to the end of the step and write them back.
+//!
+//! The [`Timeline`] does the work on plain arrays, so it is tested without an app. Balls move
+//! lazily: `circles[i]` holds ball `i` where it was `clock[i]` seconds into the step. An
+//! impact remembers how many hits each of its balls had when it was predicted; if either has
+//! been hit since, the prediction is stale and skipped.
+//!
+//! [`SimSystems::Collision`]: super::SimSystems::Collision
+//! [`SimSystems::Response`]: super::SimSystems::Response
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::SimSystems;
+use super::ball::{Ball, BallSnapshot, Position, Velocity};
+use super::collision::broad_phase::UniformGrid;
+use super::collision::narrow_phase::{
+    COINCIDENT_NORMAL, Circle, circle_contact, circles_touch, collision_point, time_of_impact,
+};
+use super::collision::{Contact, Contacts, IndexedContact, find_contacts, search_in_bands};
+use super::messages::{BallCollision, Wall, WallCollision};
+use super::movement::{contain_in_arena, wall_contact_point};
+use super::params::{BroadPhase, CollisionMode, MassModel, SimParams};
+use super::response::{normal_exchange, resolve_overlaps, separation_shares, write_back};
+use super::stats::SimStats;
+use super::step_seconds;
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<Timeline>().add_systems(
+        FixedUpdate,
+        (
+            predict_impacts.in_set(SimSystems::Collision),
+            run_timeline.in_set(SimSystems::Response),
+        )
+            .run_if(in_mode(CollisionMode::Continuous)),
+    );
+}
+
+/// A run condition: the simulation is in collision mode `mode`.
+pub fn in_mode(mode: CollisionMode) -> impl FnMut(Res<SimParams>) -> bool + Clone {
+    move |params: Res<SimParams>| params.collisions == mode
+}
+
+/// Pairs closing more slowly than this, pixels per second, count as resting, not approaching.
+/// Without it, rounding after a perfectly inelastic hit could schedule the same pair again
+/// and again at the same instant.
+pub const MIN_APPROACH_SPEED: f64 = 1e-9;
+/// A ball takes at most this many hits in one step. Only an inelastic collapse (a pile
+/// pressed together by gravity, restitution below 1) comes near it; the step then ends for
+/// that ball without further impacts, and the overlaps left at the end get the discrete
+/// mode's response. [`SimStats::cut_short_steps`] counts such steps.
+pub const MAX_HITS_PER_BALL: u32 = 8;
+/// Pairs overlapping by more than this fraction of their summed radii at the start of a step
+/// (placed so, or left by a discrete step or a cut-short one) are pushed apart at its end.
+const OVERLAP_TOLERANCE: f64 = 1e-9;
+
+/// What a step's timeline needs of the simulation's parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSpec {
+    /// Seconds.
+    pub dt: f64,
+    /// Half the arena size, pixels.
+    pub half: DVec2,
+    pub restitution: f64,
+    pub mass_model: MassModel,
+}
+
+impl StepSpec {
+    pub fn new(params: &SimParams, dt: f64) -> Self {
+        Self {
+            dt,
+            half: params.half_extents(),
+            restitution: params.restitution,
+            mass_model: params.mass_model,
+        }
+    }
+}
+
+/// A hit the timeline handled. Times are seconds into the step; indices are positions in the
+/// arrays given to [`Timeline::run`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Hit {
+    Ball {
+        a: u32,
+        b: u32,
+        time: f64,
+        /// The radius-weighted point, which for touching balls is where they touch.
+        point: DVec2,
+        /// Unit vector from `a` towards `b`.
+        normal: DVec2,
+        impulse: f64,
+        closing_speed: f64,
+    },
+    Wall {
+        ball: u32,
+        wall: Wall,
+        time: f64,
+        point: DVec2,
+        impulse: f64,
+        normal_speed: f64,
+    },
+}
+
+/// Seconds until a ball at `position` moving at `velocity` touches a wall of the arena
+/// `[-half, half]`, and which wall: zero if it already touches (or crosses) a wall it moves
+/// into. `None` if it moves into no wall, or only along axes where it is wider than the arena
+/// (the end-of-step containment centres those).
+pub fn wall_time_of_impact(
+    position: DVec2,
+    velocity: DVec2,
+    radius: f64,
+    half: DVec2,
+) -> Option<(f64, Wall)> {
+    let mut first: Option<(f64, Wall)> = None;
+    for (axis, low_wall, high_wall) in [(0, Wall::Left, Wall::Right), (1, Wall::Bottom, Wall::Top)]
+    {
+        let limit = half[axis] - radius;
+        let speed = velocity[axis];
+        if limit <= 0.0 || speed.abs() <= MIN_APPROACH_SPEED {
+            continue;
+        }
+        let (gap, wall) = if speed > 0.0 {
+            (limit - position[axis], high_wall)
+        } else {
+            (limit + position[axis], low_wall)
+        };
+        let time = (gap / speed.abs()).max(0.0);
+        if first.is_none_or(|(earliest, _)| time < earliest) {
+            first = Some((time, wall));
+        }
+    }
+    first
+}
+
+/// [`time_of_impact`] for pairs closing faster than [`MIN_APPROACH_SPEED`].
+#[inline]
+fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2) -> Option<f64> {
+    let offset = b.center - a.center;
+    let closing = (velocity_a - velocity_b).dot(offset);
+    if closing <= 0.0
+        || closing * closing <= MIN_APPROACH_SPEED * MIN_APPROACH_SPEED * offset.length_squared()
+    {
+        return None;
+    }
+    time_of_impact(a, velocity_a, b, velocity_b)
+}
+
+/// `other` values from here up name a wall, below it a ball.
+const WALL_BASE: u32 = u32::MAX - 3;
+const WALLS: [Wall; 4] = [Wall::Left, Wall::Right, Wall::Bottom, Wall::Top];
+
+/// A predicted impact: ball `a` with ball `other` (then `a < other`) or with a wall.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Impact {
+    /// Seconds into the step.
+    time: f64,
+    a: u32,
+    other: u32,
+    /// How many hits `a` and `other` had had when this was predicted.
+    hits_a: u32,
+    hits_other: u32,
+}
+
+impl Impact {
+    fn key(&self) -> (u32, u32, u32, u32) {
+        (self.a, self.other, self.hits_a, self.hits_other)
+    }
+}
+
+impl Eq for Impact {}
+
+impl Ord for Impact {
+    /// Earliest first; equal times in a fixed order of the balls, so the result never depends
+    /// on the order in which the impacts were found.
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.time
+            .total_cmp(&other.time)
+            .then_with(|| self.key().cmp(&other.key()))
+    }
+}
+
+impl PartialOrd for Impact {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// What the collision stage's search finds for a pair.
+#[derive(Clone, Copy, Debug)]
+enum Prediction {
+    Impact(Impact),
+    /// Overlapping at the start of the step.
+    Overlap(u32, u32),
+}
+
+/// The balls whose velocity changed during the step, filed by the grid cell of the circle
+/// swept by the rest of their path: an intrusive list per cell. An entry is current while
+/// its ball's hit count is still the one it was filed with.
+#[derive(Debug, Default)]
+struct Rerouted {
+    /// First entry of each cell's list, or `NONE`.
+    head: Vec<u32>,
+    entries: Vec<RerouteEntry>,
+    /// Cells whose `head` is set, to clear them cheaply.
+    used_cells: Vec<u32>,
+    /// Largest swept radius filed.
+    reach: f64,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct RerouteEntry {
+    ball: u32,
+    hits: u32,
+    next: u32,
+}
+
+impl Rerouted {
+    const NONE: u32 = u32::MAX;
+
+    fn reset(&mut self, cell_count: usize) {
+        for &cell in &self.used_cells {
+            if let Some(head) = self.head.get_mut(cell as usize) {
+                *head = Self::NONE;
+            }
+        }
+        self.head.resize(cell_count, Self::NONE);
+        self.head.truncate(cell_count);
+        self.used_cells.clear();
+        self.entries.clear();
+        self.reach = 0.0;
+    }
+
+    fn insert(&mut self, cell: usize, ball: u32, hits: u32, reach: f64) {
+        if self.head[cell] == Self::NONE {
+            self.used_cells.push(cell as u32);
+        }
+        self.entries.push(RerouteEntry {
+            ball,
+            hits,
+            next: self.head[cell],
+        });
+        self.head[cell] = (self.entries.len() - 1) as u32;
+        self.reach = self.reach.max(reach);
+    }
+
+    /// Visits the balls whose current entry is in `cells`.
+    fn for_each_in_cells(
+        &self,
+        cells: std::ops::Range<usize>,
+        hits: &[u32],
+        mut visit: impl FnMut(u32),
+    ) {
+        for cell in cells {
+            let mut entry = self.head[cell];
+            while entry != Self::NONE {
+                let RerouteEntry {
+                    ball,
+                    hits: filed,
+                    next,
+                } = self.entries[entry as usize];
+                if hits[ball as usize] == filed {
+                    visit(ball);
+                }
+                entry = next;
+            }
+        }
+    }
+}
+
+/// The continuous mode's working state, kept between steps to reuse its buffers.
+#[derive(Resource, Debug, Default)]
+pub struct Timeline {
+    /// Each ball's circle swept over the whole step, sorted into cells.
+    grid: UniformGrid,
+    swept: Vec<Circle>,
+    /// Largest radius in `swept`.
+    grid_reach: f64,
+    predictions: Vec<Prediction>,
+    queue: BinaryHeap<Reverse<Impact>>,
+    overlapping: Vec<(u32, u32)>,
+    /// Seconds into the step at which each ball's circle is current.
+    clock: Vec<f64>,
+    /// Hits each ball has had this step.
+    hits: Vec<u32>,
+    rerouted: Rerouted,
+    /// Contacts for the discrete response of a step cut short.
+    fallback: Vec<IndexedContact>,
+    /// Hits handled by the last [`run`](Self::run).
+    pub handled: usize,
+    /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
+    pub cut_short: bool,
+}
+
+impl Timeline {
+    /// The collision stage's part: every impact of the coming step that the balls' current
+    /// paths lead to. `circles` are the balls at the start of the step, `velocities` their
+    /// velocities for the whole step.
+    pub fn predict(&mut self, circles: &[Circle], velocities: &[DVec2], spec: StepSpec) {
+        let dt = spec.dt;
+        self.swept.clear();
+        self.swept
+            .extend(circles.iter().zip(velocities).map(|(circle, velocity)| {
+                Circle::new(
+                    circle.center + *velocity * (0.5 * dt),
+                    circle.radius + velocity.length() * (0.5 * dt),
+                )
+            }));
+        self.grid_reach = self.swept.iter().map(|s| s.radius).fold(0.0, f64::max);
+        self.grid.rebuild(&self.swept);
+        self.predictions.clear();
+        search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
+            grid.for_each_candidate_pair_in_rows(rows, |i, j, swept_i, swept_j| {
+                // The swept circles bound the paths: if they do not touch, the balls cannot.
+                if !circles_touch(swept_i, swept_j) {
+                    return;
+                }
+                let (a, b) = (i.min(j), i.max(j));
+                let (ca, cb) = (circles[a as usize], circles[b as usize]);
+                let (va, vb) = (velocities[a as usize], velocities[b as usize]);
+                let reach = (ca.radius + cb.radius) * (1.0 - OVERLAP_TOLERANCE);
+                if ca.center.distance_squared(cb.center) < reach * reach {
+                    found.push(Prediction::Overlap(a, b));
+                }
+                if let Some(time) = approach_time(ca, va, cb, vb).filter(|&t| t <= dt) {
+                    found.push(Prediction::Impact(Impact {
+                        time,
+                        a,
+                        other: b,
+                        hits_a: 0,
+                        hits_other: 0,
+                    }));
+                }
+            });
+        });
+        for (index, (circle, velocity)) in circles.iter().zip(velocities).enumerate() {
+            if let Some((time, wall)) =
+                wall_time_of_impact(circle.center, *velocity, circle.radius, spec.half)
+                && time <= dt
+            {
+                self.predictions.push(Prediction::Impact(Impact {
+                    time,
+                    a: index as u32,
+                    other: WALL_BASE + wall as u32,
+                    hits_a: 0,
+                    hits_other: 0,
+                }));
+            }
+        }
+    }
+
+    /// The response stage's part: handles the predicted impacts in time order, predicting
+    /// anew for every ball hit, then moves every ball to the end of the step. `circles` and
+    /// `velocities` must be what [`predict`](Self::predict) was given; they are updated in
+    /// place. Calls `on_hit` for each hit, in the order handled.
+    pub fn run(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        spec: StepSpec,
+        mut on_hit: impl FnMut(Hit),
+    ) {
+        let count = circles.len();
+        self.clock.clear();
+        self.clock.resize(count, 0.0);
+        self.hits.clear();
+        self.hits.resize(count, 0);
+        self.rerouted.reset(self.grid.cell_count());
+        self.queue.clear();
+        self.overlapping.clear();
+        for prediction in &self.predictions {
+            match *prediction {
+                Prediction::Impact(impact) => self.queue.push(Reverse(impact)),
+                Prediction::Overlap(a, b) => self.overlapping.push((a, b)),
+            }
+        }
+        self.handled = 0;
+        self.cut_short = false;
+        while let Some(Reverse(impact)) = self.queue.pop() {
+            let a = impact.a as usize;
+            let is_wall = impact.other >= WALL_BASE;
+            if self.hits[a] != impact.hits_a
+                || (!is_wall && self.hits[impact.other as usize] != impact.hits_other)
+            {
+                continue; // stale: a ball in it has been hit since
+            }
+            if self.hits[a] == MAX_HITS_PER_BALL
+                || (!is_wall && self.hits[impact.other as usize] == MAX_HITS_PER_BALL)
+            {
+                self.cut_short = true;
+                continue;
+            }
+            let now = impact.time;
+            self.advance(circles, velocities, a, now);
+            if is_wall {
+                let wall = WALLS[(impact.other - WALL_BASE) as usize];
+                if let Some(bounce) = bounce_off_wall(circles[a], &mut velocities[a], wall, spec) {
+                    circles[a].center = bounce.center;
+                    on_hit(Hit::Wall {
+                        ball: impact.a,
+                        wall,
+                        time: now,
+                        point: bounce.point,
+                        impulse: bounce.impulse,
+                        normal_speed: bounce.normal_speed,
+                    });
+                    self.hits[a] += 1;
+                    self.handled += 1;
+                    self.predict_for(circles, velocities, a, now, spec);
+                }
+            } else {
+                let b = impact.other as usize;
+                self.advance(circles, velocities, b, now);
+                let (ca, cb) = (circles[a], circles[b]);
+                let offset = cb.center - ca.center;
+                let distance = offset.length();
+                let normal = if distance > 0.0 {
+                    offset / distance
+                } else {
+                    COINCIDENT_NORMAL
+                };
+                let (inverse_mass_a, inverse_mass_b) = (
+                    spec.mass_model.inverse_mass(ca.radius),
+                    spec.mass_model.inverse_mass(cb.radius),
+                );
+                let Some(exchange) = normal_exchange(
+                    velocities[a],
+                    velocities[b],
+                    inverse_mass_a,
+                    inverse_mass_b,
+                    normal,
+                    spec.restitution,
+                ) else {
+                    continue;
+                };
+                velocities[a] = exchange.velocity_a;
+                velocities[b] = exchange.velocity_b;
+                on_hit(Hit::Ball {
+                    a: impact.a,
+                    b: impact.other,
+                    time: now,
+                    point: collision_point(ca, cb),
+                    normal,
+                    impulse: exchange.impulse,
+                    closing_speed: exchange.closing_speed,
+                });
+                self.hits[a] += 1;
+                self.hits[b] += 1;
+                self.handled += 1;
+                self.predict_for(circles, velocities, a, now, spec);
+                self.predict_for(circles, velocities, b, now, spec);
+            }
+        }
+        for index in 0..count {
+            self.advance(circles, velocities, index, spec.dt);
+        }
+        if self.cut_short {
+            // Some balls stopped taking hits: whatever overlaps now gets the discrete response.
+            self.fallback.clear();
+            find_contacts(
+                circles,
+                BroadPhase::Grid,
+                &mut self.grid,
+                &mut self.fallback,
+            );
+            let pairs = self.fallback.iter().map(|contact| (contact.a, contact.b));
+            resolve_overlaps(
+                pairs,
+                circles,
+                velocities,
+                spec.mass_model,
+                spec.restitution,
+                |a, b, geometry, exchange| {
+                    on_hit(Hit::Ball {
+                        a,
+                        b,
+                        time: spec.dt,
+                        point: geometry.point,
+                        normal: geometry.normal,
+                        impulse: exchange.impulse,
+                        closing_speed: exchange.closing_speed,
+                    });
+                },
+            );
+        }
+        self.push_apart_overlaps(circles, spec);
+        // Rounding can leave a ball a hair past a wall, and pushing overlaps apart can push
+        // one into it: the same containment as the discrete mode puts it back.
+        for (index, (circle, velocity)) in circles.iter_mut().zip(velocities.iter_mut()).enumerate()
+        {
+            let contained = contain_in_arena(
+                circle.center,
+                *velocity,
+                circle.radius,
+                spec.half,
+                spec.restitution,
+            );
+            (circle.center, *velocity) = (contained.position, contained.velocity);
+            for wall_hit in contained.hits.into_iter().flatten() {
+                on_hit(Hit::Wall {
+                    ball: index as u32,
+                    wall: wall_hit.wall,
+                    time: spec.dt,
+                    point: wall_contact_point(wall_hit.wall, circle.center, spec.half),
+                    impulse: spec.mass_model.mass(circle.radius)
+                        * (1.0 + spec.restitution)
+                        * wall_hit.normal_speed,
+                    normal_speed: wall_hit.normal_speed,
+                });
+            }
+        }
+    }
+
+    /// Moves ball `index` along its path to `time` seconds into the step.
+    #[inline]
+    fn advance(&mut self, circles: &mut [Circle], velocities: &[DVec2], index: usize, time: f64) {
+        circles[index].center += velocities[index] * (time - self.clock[index]);
+        self.clock[index] = time;
+    }
+
+    /// Queues ball `index`'s next wall and ball impacts after its velocity changed at `now`.
+    fn predict_for(
+        &mut self,
+        circles: &[Circle],
+        velocities: &[DVec2],
+        index: usize,
+        now: f64,
+        spec: StepSpec,
+    ) {
+        if self.hits[index] == MAX_HITS_PER_BALL {
+            return;
+        }
+        let (circle, velocity) = (circles[index], velocities[index]);
+        let hits = &self.hits;
+        let queue = &mut self.queue;
+        if let Some((time, wall)) =
+            wall_time_of_impact(circle.center, velocity, circle.radius, spec.half)
+            && now + time <= spec.dt
+        {
+            queue.push(Reverse(Impact {
+                time: now + time,
+                a: index as u32,
+                other: WALL_BASE + wall as u32,
+                hits_a: hits[index],
+                hits_other: 0,
+            }));
+        }
+        let rest = spec.dt - now;
+        let swept = Circle::new(
+            circle.center + velocity * (0.5 * rest),
+            circle.radius + velocity.length() * (0.5 * rest),
+        );
+        self.rerouted.insert(
+            self.grid.cell_index(swept.center),
+            index as u32,
+            self.hits[index],
+            swept.radius,
+        );
+        let clock = &self.clock;
+        let mut consider = |other: u32| {
+            let other_index = other as usize;
+            if other_index == index {
+                return;
+            }
+            let elapsed = now - clock[other_index];
+            let other_circle = Circle::new(
+                circles[other_index].center + velocities[other_index] * elapsed,
+                circles[other_index].radius,
+            );
+            let Some(time) = approach_time(circle, velocity, other_circle, velocities[other_index])
+                .map(|t| now + t)
+                .filter(|&t| t <= spec.dt)
+            else {
+                return;
+            };
+            let (a, b) = if index < other_index {
+                (index, other_index)
+            } else {
+                (other_index, index)
+            };
+            queue.push(Reverse(Impact {
+                time,
+                a: a as u32,
+                other: b as u32,
+                hits_a: hits[a],
+                hits_other: hits[b],
+            }));
+        };
+        // Balls on their first path of the step are filed in the grid by the circle that path
+        // sweeps; the ones that changed course since, in `rerouted`.
+        let near = DVec2::splat(swept.radius + self.grid_reach);
+        self.grid.for_each_near(
+            swept.center - near,
+            swept.center + near,
+            |other, other_swept| {
+                if hits[other as usize] == 0 && circles_touch(swept, other_swept) {
+                    consider(other);
+                }
+            },
+        );
+        let near = DVec2::splat(swept.radius + self.rerouted.reach);
+        let rerouted = &self.rerouted;
+        self.grid
+            .for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
+                rerouted.for_each_in_cells(cells, hits, &mut consider);
+            });
+    }
+
+    /// Pushes apart, shared by inverse mass, the pairs that overlapped at the start of the
+    /// step and still do.
+    fn push_apart_overlaps(&self, circles: &mut [Circle], spec: StepSpec) {
+        for &(a, b) in &self.overlapping {
+            let (a, b) = (a as usize, b as usize);
+            let Some(geometry) = circle_contact(circles[a], circles[b]) else {
+                continue;
+            };
+            let (back, forward) = separation_shares(
+                geometry.depth,
+                spec.mass_model.inverse_mass(circles[a].radius),
+                spec.mass_model.inverse_mass(circles[b].radius),
+            );
+            circles[a].center -= geometry.normal * back;
+            circles[b].center += geometry.normal * forward;
+        }
+    }
+}
+
+/// A ball's bounce off a wall: [`bounce_off_wall`]'s result.
+struct WallBounce {
+    /// The centre, set exactly against the wall.
+    center: DVec2,
+    point: DVec2,
+    impulse: f64,
+    normal_speed: f64,
+}
+
+/// Reflects a ball that touches `wall` and moves into it: the normal velocity is reversed and
+/// scaled by the restitution. `None` (and no change) if it moves away from the wall.
+fn bounce_off_wall(
+    circle: Circle,
+    velocity: &mut DVec2,
+    wall: Wall,
+    spec: StepSpec,
+) -> Option<WallBounce> {
+    let outward = wall.outward_normal();
+    let normal_speed = velocity.dot(outward);
+    if normal_speed <= 0.0 {
+        return None;
+    }
+    *velocity -= outward * ((1.0 + spec.restitution) * normal_speed);
+    let axis = usize::from(outward.y != 0.0);
+    let mut center = circle.center;
+    center[axis] = outward[axis] * (spec.half[axis] - circle.radius);
+    Some(WallBounce {
+        center,
+        point: wall_contact_point(wall, center, spec.half),
+        impulse: spec.mass_model.mass(circle.radius) * (1.0 + spec.restitution) * normal_speed,
+        normal_speed,
+    })
+}
+
+fn predict_impacts(
+    time: Res<Time>,
+    params: Res<SimParams>,
+    snapshot: Res<BallSnapshot>,
+    mut timeline: ResMut<Timeline>,
+) {
+    let spec = StepSpec::new(&params, step_seconds(&time, &params));
+    timeline.predict(&snapshot.circles, &snapshot.velocities, spec);
+}
+
+fn run_timeline(
+    time: Res<Time>,
+    params: Res<SimParams>,
+    mut stats: ResMut<SimStats>,
+    mut timeline: ResMut<Timeline>,
+    mut snapshot: ResMut<BallSnapshot>,
+    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut contacts: ResMut<Contacts>,
+    mut collisions: MessageWriter<BallCollision>,
+    mut wall_hits: MessageWriter<WallCollision>,
+) {
+    let spec = StepSpec::new(&params, step_seconds(&time, &params));
+    let step_start = stats.sim_time;
+    let BallSnapshot {
+        entities,
+        circles,
+        velocities,
+    } = &mut *snapshot;
+    contacts.0.clear();
+    timeline.run(circles, velocities, spec, |hit| match hit {
+        Hit::Ball {
+            a,
+            b,
+            time,
+            point,
+            normal,
+            impulse,
+            closing_speed,
+        } => {
+            let (entity_a, entity_b) = (entities[a as usize], entities[b as usize]);
+            contacts.0.push(Contact {
+                a: entity_a,
+                b: entity_b,
+                index_a: a,
+                index_b: b,
+                normal,
+                depth: 0.0,
+                point,
+            });
+            collisions.write(BallCollision {
+                a: entity_a,
+                b: entity_b,
+                time: step_start + time,
+                point,
+                normal,
+                impulse,
+                normal_speed: closing_speed,
+            });
+        }
+        Hit::Wall {
+            ball,
+            wall,
+            time,
+            point,
+            impulse,
+            normal_speed,
+        } => {
+            wall_hits.write(WallCollision {
+                ball: entities[ball as usize],
+                wall,
+                time: step_start + time,
+                point,
+                impulse,
+                normal_speed,
+            });
+        }
+    });
+    if timeline.cut_short {
+        stats.cut_short_steps += 1;
+    }
+    write_back(entities, &mut balls, |index| {
+        Some((circles[index].center, velocities[index]))
+    });
+}

@@ -1,0 +1,217 @@
+//! Continuous collisions: nothing tunnels at 20 diameters a step, energy is kept, and the
+//! result does not depend on the order in which pairs are found.
+
+use ballpit::prelude::*;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::common::{DT, Recorded, app_with, ball, record_collisions, shipped_scene, states, step};
+
+fn params(mode: CollisionMode, width: f64, height: f64) -> SimParams {
+    SimParams {
+        arena_size: DVec2::new(width, height),
+        collisions: mode,
+        ..default()
+    }
+}
+
+/// Pixels per second for `diameters` diameters of a `radius` ball per step.
+fn speed(diameters: f64, radius: f64) -> f64 {
+    diameters * 2.0 * radius / DT
+}
+
+#[test]
+fn head_on_at_20_diameters_per_step_bounces_where_discrete_tunnels() {
+    let v = speed(20.0, 5.0); // 200 px a step
+    let balls = [
+        ball(-100.0, 0.0, v, 0.0, 5.0),
+        ball(100.0, 0.0, -v, 0.0, 5.0),
+    ];
+    let mut app = app_with(params(CollisionMode::Continuous, 2000.0, 200.0), &balls);
+    step(&mut app, 1);
+    let [a, b] = states(&mut app)[..] else {
+        panic!("two balls")
+    };
+    // They close 400 px a step over a 190 px gap: contact at 0.475 of the step at x = -5 and
+    // 5; equal masses swap velocities and travel back for the remaining 0.525 step (105 px).
+    // (The fixed step is 1/60 s rounded to whole nanoseconds: 4e-6 px over the step.)
+    assert!((a.position.x + 110.0).abs() < 1e-5, "{}", a.position);
+    assert!((b.position.x - 110.0).abs() < 1e-5, "{}", b.position);
+    assert!((a.velocity.x + v).abs() < 1e-9 && (b.velocity.x - v).abs() < 1e-9);
+
+    // The tutorial's method only looks at the end of the step and misses the hit.
+    let mut app = app_with(params(CollisionMode::Discrete, 2000.0, 200.0), &balls);
+    step(&mut app, 1);
+    let [a, b] = states(&mut app)[..] else {
+        panic!("two balls")
+    };
+    assert!(
+        a.position.x > b.position.x,
+        "discrete mode should tunnel here"
+    );
+}
+
+#[test]
+fn a_ball_at_20_diameters_per_step_stays_in_the_arena_and_keeps_its_speed() {
+    let v = speed(20.0, 5.0);
+    let mut app = app_with(
+        params(CollisionMode::Continuous, 400.0, 300.0),
+        &[ball(0.0, 0.0, v, v * 0.37, 5.0)],
+    );
+    record_collisions(&mut app);
+    for step_index in 0..120 {
+        step(&mut app, 1);
+        let b = states(&mut app)[0];
+        let reach = b.position.abs() + DVec2::splat(b.radius);
+        assert!(
+            reach.x <= 200.0 + 1e-9 && reach.y <= 150.0 + 1e-9,
+            "step {step_index}: {} outside",
+            b.position
+        );
+        let expected = DVec2::new(v, v * 0.37).length();
+        assert!((b.velocity.length() - expected).abs() < 1e-9 * expected);
+    }
+    // 120 steps of 200 px along x over a 390 px track: about 61 hits on the side walls.
+    let recorded = app.world().resource::<Recorded>();
+    let side_hits = recorded
+        .wall_hits
+        .iter()
+        .filter(|hit| matches!(hit.wall, Wall::Left | Wall::Right))
+        .count();
+    assert!((60..=62).contains(&side_hits), "{side_hits} side-wall hits");
+}
+
+#[test]
+fn balls_on_a_line_at_up_to_10_diameters_per_step_never_pass_each_other() {
+    // Ten balls on one horizontal line: any tunnelling would change their order.
+    let balls: Vec<BallState> = (0..10)
+        .map(|i| {
+            let v = speed(10.0, 4.0) * (((i * 7) % 10) as f64 / 9.0 * 2.0 - 1.0);
+            ball(-450.0 + i as f64 * 100.0, 0.0, v, 0.0, 4.0 + (i % 3) as f64)
+        })
+        .collect();
+    let mut app = app_with(params(CollisionMode::Continuous, 1000.0, 100.0), &balls);
+    for step_index in 0..300 {
+        step(&mut app, 1);
+        let now = states(&mut app);
+        for pair in now.windows(2) {
+            let gap = pair[1].position.x - pair[0].position.x - pair[0].radius - pair[1].radius;
+            assert!(
+                gap >= -1e-9,
+                "step {step_index}: overlap or pass, gap {gap}"
+            );
+        }
+    }
+}
+
+#[test]
+fn newtons_cradle_passes_the_speed_to_the_last_ball() {
+    let setup = shipped_scene("newtons_cradle.ron")
+        .build("newtons_cradle.ron")
+        .unwrap();
+    let mut app = app_with(
+        SimParams {
+            collisions: CollisionMode::Continuous,
+            ..setup.params.clone()
+        },
+        &setup.balls,
+    );
+    // The first ball reaches the row after 260 px at 300 px/s: 52 steps; run a little more.
+    step(&mut app, 60);
+    let balls = states(&mut app);
+    let last = balls.last().unwrap();
+    assert!((last.velocity.x - 300.0).abs() < 1e-9, "{}", last.velocity);
+    for other in &balls[..balls.len() - 1] {
+        assert!(other.velocity.length() < 1e-9, "{}", other.velocity);
+    }
+    assert!(balls.iter().all(|b| b.velocity.y == 0.0));
+}
+
+#[test]
+fn standard_gas_keeps_its_energy_to_one_part_in_a_million() {
+    let setup = shipped_scene("gas.ron").build("gas.ron").unwrap();
+    assert_eq!(setup.balls.len(), 1000);
+    let mut app = app_with(
+        SimParams {
+            collisions: CollisionMode::Continuous,
+            ..setup.params.clone()
+        },
+        &setup.balls,
+    );
+    let start = StateSummary::measure(app.world_mut());
+    step(&mut app, 600);
+    let end = StateSummary::measure(app.world_mut());
+    let change = (end.kinetic_energy - start.kinetic_energy) / start.kinetic_energy;
+    assert!(change.abs() < 1e-6, "relative change {change}");
+    // And nothing overlaps: the continuous mode never lets a pair interpenetrate.
+    assert!(
+        end.max_overlap_rel < 1e-9,
+        "overlap {}",
+        end.max_overlap_rel
+    );
+    assert!(app.world().resource::<SimStats>().ball_collisions > 50_000);
+}
+
+#[test]
+fn three_balls_meeting_in_one_step_end_the_same_whatever_the_order_found() {
+    // A hits B early in the step and B then hits C; and a symmetric pinch where D and F
+    // reach E at the same instant from both sides. Discrete mode would see both overlaps at
+    // once and resolve them in the order the pairs were found.
+    let chain = [
+        ball(-60.0, 0.0, 3_000.0, 0.0, 10.0),
+        ball(-15.0, 2.0, 0.0, 0.0, 12.0),
+        ball(25.0, -3.0, -600.0, 0.0, 8.0),
+    ];
+    let pinch = [
+        ball(-60.0, 100.0, 3_000.0, 0.0, 10.0),
+        ball(0.0, 100.0, 0.0, 0.0, 10.0),
+        ball(60.0, 100.0, -3_000.0, 0.0, 10.0),
+    ];
+    let orders = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut results: Vec<Vec<BallState>> = Vec::new();
+    for order in orders {
+        let balls: Vec<BallState> = order
+            .iter()
+            .map(|&i| chain[i])
+            .chain(order.iter().map(|&i| pinch[i]))
+            .collect();
+        let mut app = app_with(params(CollisionMode::Continuous, 400.0, 400.0), &balls);
+        step(&mut app, 1);
+        let after = states(&mut app);
+        // Back to the canonical order.
+        let mut canonical = vec![after[0]; 6];
+        for (slot, &i) in order.iter().enumerate() {
+            canonical[i] = after[slot];
+            canonical[3 + i] = after[3 + slot];
+        }
+        results.push(canonical);
+    }
+    for result in &results[1..] {
+        for (got, want) in result.iter().zip(&results[0]) {
+            assert!(got.position.distance(want.position) < 1e-9);
+            assert!(got.velocity.distance(want.velocity) < 1e-9);
+        }
+    }
+    let first = &results[0];
+    // The chain really collided twice within the step: C now moves right.
+    assert!(first[2].velocity.x > 0.0, "{}", first[2].velocity);
+    // The pinch: equal masses, e = 1: D and F bounce back at full speed and E stays.
+    assert!(
+        (first[3].velocity.x + 3_000.0).abs() < 1e-9,
+        "{}",
+        first[3].velocity
+    );
+    assert!(first[4].velocity.length() < 1e-9, "{}", first[4].velocity);
+    assert!(
+        (first[5].velocity.x - 3_000.0).abs() < 1e-9,
+        "{}",
+        first[5].velocity
+    );
+}
