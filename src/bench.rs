@@ -13,19 +13,21 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::headless::{DEFAULT_DT, headless_app_with_threads, median};
-use crate::sim::{BroadPhase, Contacts, SceneFile, SimParams};
+use crate::sim::{BroadPhase, CollisionMode, Contacts, SceneFile, SimParams, SimStats};
 
 /// The standard gas, built in so the bench runs from any directory.
 pub const STANDARD_GAS: &str = include_str!("../assets/scenes/gas.ron");
 /// Steps run before timing starts (first-touch allocations, caches).
 const WARM_UP_STEPS: u64 = 5;
 
-/// One case: how many balls, how many timed steps, which broad phase.
+/// One case: how many balls, how many timed steps, which broad phase and collision mode.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BenchCase {
     pub balls: usize,
     pub steps: u64,
+    /// Used by the discrete mode; the continuous mode always uses the grid.
     pub broad_phase: BroadPhase,
+    pub collisions: CollisionMode,
 }
 
 /// What one case measured.
@@ -39,6 +41,12 @@ pub struct CaseResult {
     pub ms_per_step_median: f64,
     pub ns_per_ball_step: f64,
     pub contacts_per_step: f64,
+    /// Ball–ball collisions (momentum exchanges) per step.
+    pub collisions_per_step: f64,
+    /// Ball–ball collisions per simulated second.
+    pub collisions_per_sim_second: f64,
+    /// Ball–ball collisions handled per second of computing.
+    pub collisions_per_cpu_second: f64,
     /// Peak resident memory of the process, MiB (Linux only).
     pub peak_rss_mib: Option<f64>,
 }
@@ -52,10 +60,13 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
     let setup = scene.build("gas.ron")?;
     let mut app = headless_app_with_threads(DEFAULT_DT, Some(threads));
     setup.apply(app.world_mut());
-    app.world_mut().resource_mut::<SimParams>().broad_phase = case.broad_phase;
+    let mut params = app.world_mut().resource_mut::<SimParams>();
+    params.broad_phase = case.broad_phase;
+    params.collisions = case.collisions;
     for _ in 0..WARM_UP_STEPS {
         app.update();
     }
+    let collisions_before = app.world().resource::<SimStats>().ball_collisions;
     let mut step_ms = Vec::with_capacity(case.steps as usize);
     let mut contacts = 0usize;
     for _ in 0..case.steps {
@@ -64,6 +75,10 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
         step_ms.push(started.elapsed().as_secs_f64() * 1e3);
         contacts += app.world().resource::<Contacts>().0.len();
     }
+    let total_ms: f64 = step_ms.iter().sum();
+    let collisions =
+        (app.world().resource::<SimStats>().ball_collisions - collisions_before) as f64;
+    let steps = case.steps.max(1) as f64;
     let median = median(&mut step_ms);
     Ok(CaseResult {
         case,
@@ -71,7 +86,10 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
         threads,
         ms_per_step_median: median,
         ns_per_ball_step: median * 1e6 / case.balls.max(1) as f64,
-        contacts_per_step: contacts as f64 / case.steps.max(1) as f64,
+        contacts_per_step: contacts as f64 / steps,
+        collisions_per_step: collisions / steps,
+        collisions_per_sim_second: collisions / (steps * DEFAULT_DT),
+        collisions_per_cpu_second: collisions / (total_ms.max(f64::MIN_POSITIVE) * 1e-3),
         peak_rss_mib: peak_rss_mib(),
     })
 }
@@ -118,6 +136,11 @@ pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, 
             broad_phase,
             "--threads",
             &threads.to_string(),
+            "--collisions",
+            match case.collisions {
+                CollisionMode::Continuous => "continuous",
+                CollisionMode::Discrete => "discrete",
+            },
         ])
         .output()
         .map_err(|e| {
@@ -148,6 +171,9 @@ pub struct BenchRow {
     pub all_cores: CaseResult,
     /// The all-pairs reference on one core, where it was run.
     pub all_pairs: Option<CaseResult>,
+    /// The same gas in continuous mode, on one core and on all.
+    pub continuous_one_core: CaseResult,
+    pub continuous_all_cores: CaseResult,
 }
 
 impl BenchRow {
@@ -162,9 +188,11 @@ impl BenchRow {
     }
 }
 
-/// The bench table as text.
+/// The bench tables as text: the discrete mode's scaling, then continuous against discrete.
 pub fn format_table(rows: &[BenchRow]) -> String {
-    let mut text = format!(
+    let mut text =
+        String::from("Discrete mode (move, find overlaps, respond), grid broad phase:\n");
+    text += &format!(
         "{:>8} {:>12} {:>14} {:>14} {:>12} {:>10} {:>13} {:>11}\n",
         "balls",
         "ms/step 1c",
@@ -193,6 +221,40 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             row.all_cores.ms_per_step_median,
             row.speedup_from_cores(),
             versus
+        );
+    }
+    text += "\nContinuous against discrete (collisions = momentum exchanges between balls):\n";
+    text += &format!(
+        "{:>8} {:>10} {:>10} {:>12} {:>14} {:>14} {:>10} {:>12} {:>14} {:>14} {:>12}\n",
+        "balls",
+        "cont 1c ms",
+        "cont 2c ms",
+        "cont coll/st",
+        "cont coll/sim-s",
+        "cont coll/cpu-s",
+        "disc 1c ms",
+        "disc coll/st",
+        "disc coll/sim-s",
+        "disc coll/cpu-s",
+        "cont RSS MB"
+    );
+    for row in rows {
+        let (continuous, discrete) = (&row.continuous_one_core, &row.one_core);
+        text += &format!(
+            "{:>8} {:>10.3} {:>10.3} {:>12.0} {:>14.0} {:>14.0} {:>10.3} {:>12.0} {:>14.0} {:>14.0} {:>12}\n",
+            row.balls,
+            continuous.ms_per_step_median,
+            row.continuous_all_cores.ms_per_step_median,
+            continuous.collisions_per_step,
+            continuous.collisions_per_sim_second,
+            continuous.collisions_per_cpu_second,
+            discrete.ms_per_step_median,
+            discrete.collisions_per_step,
+            discrete.collisions_per_sim_second,
+            discrete.collisions_per_cpu_second,
+            continuous
+                .peak_rss_mib
+                .map_or("-".to_string(), |mib| format!("{:.1}", mib * 1.048_576)),
         );
     }
     text

@@ -12,7 +12,7 @@ use crate::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_chil
 use crate::headless::{DEFAULT_DT, StateDump, run_scene_with_threads};
 use crate::play::{CurrentScene, PlayOptions, play};
 use crate::sim::params::MAX_BALLS;
-use crate::sim::{BroadPhase, SceneFile};
+use crate::sim::{BroadPhase, CollisionMode, SceneFile};
 
 /// The scene played when no `--scene` is given, built in so it works from any directory.
 const DEMO_SCENE: &str = include_str!("../assets/scenes/demo.ron");
@@ -56,6 +56,12 @@ pub struct PlayArgs {
     /// Frames to run before the screenshot.
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
+    /// Collision mode, overriding the scene's.
+    #[arg(long, value_enum)]
+    pub collisions: Option<CollisionsArg>,
+    /// Start paused (Space runs it).
+    #[arg(long)]
+    pub paused: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -96,6 +102,8 @@ pub struct BenchOneArgs {
     pub broad_phase: BroadPhaseArg,
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
     pub threads: u64,
+    #[arg(long, value_enum, default_value_t = CollisionsArg::Discrete)]
+    pub collisions: CollisionsArg,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -109,6 +117,23 @@ impl From<BroadPhaseArg> for BroadPhase {
         match arg {
             BroadPhaseArg::Grid => BroadPhase::Grid,
             BroadPhaseArg::AllPairs => BroadPhase::AllPairs,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CollisionsArg {
+    /// Every impact at its exact time, in time order (the default).
+    Continuous,
+    /// The tutorial's method: move, find overlaps, respond, separate.
+    Discrete,
+}
+
+impl From<CollisionsArg> for CollisionMode {
+    fn from(arg: CollisionsArg) -> Self {
+        match arg {
+            CollisionsArg::Continuous => CollisionMode::Continuous,
+            CollisionsArg::Discrete => CollisionMode::Discrete,
         }
     }
 }
@@ -139,6 +164,9 @@ pub struct RunArgs {
     /// Worker threads for the parallel parts of the stages (default: as many as cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
     pub threads: Option<u64>,
+    /// Collision mode, overriding the scene's (default: continuous).
+    #[arg(long, value_enum)]
+    pub collisions: Option<CollisionsArg>,
 }
 
 fn parse_step_seconds(text: &str) -> Result<f64, String> {
@@ -169,13 +197,18 @@ impl Cli {
     }
 }
 
-/// Applies `--balls` and `--seed` to the scene's `generate`, which must exist.
-fn override_generation(
+/// Applies `--collisions`, then `--balls` and `--seed` to the scene's `generate`, which must
+/// exist for those two.
+fn override_scene(
     scene: &mut SceneFile,
     origin: &str,
+    collisions: Option<CollisionsArg>,
     balls: Option<usize>,
     seed: Option<u64>,
 ) -> Result<(), Box<dyn Error>> {
+    if let Some(mode) = collisions {
+        scene.collisions = Some(mode.into());
+    }
     if balls.is_none() && seed.is_none() {
         return Ok(());
     }
@@ -198,7 +231,7 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
             "demo.ron".to_string(),
         ),
     };
-    override_generation(&mut file, &origin, args.balls, args.seed)?;
+    override_scene(&mut file, &origin, args.collisions, args.balls, args.seed)?;
     // Refuse a bad scene here, with exit code 1, rather than in the window.
     let arena = file.build(&origin)?.params.arena_size.as_vec2();
     let screenshot = args.screenshot.map(|path| (path, args.frames));
@@ -206,6 +239,7 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
         scene: CurrentScene { file, origin },
         arena,
         screenshot,
+        paused: args.paused,
     }) {
         bevy::app::AppExit::Success => Ok(()),
         bevy::app::AppExit::Error(code) => Err(format!("the game exited with code {code}").into()),
@@ -215,7 +249,7 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
 fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     let origin = args.scene.display().to_string();
     let mut scene = SceneFile::load(&args.scene)?;
-    override_generation(&mut scene, &origin, args.balls, args.seed)?;
+    override_scene(&mut scene, &origin, args.collisions, args.balls, args.seed)?;
     let setup = scene.build(&origin)?;
     let threads = args.threads.map(|n| n as usize);
     let (mut app, report) = run_scene_with_threads(&setup, args.steps, args.dt, threads);
@@ -237,23 +271,30 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     let mut rows = Vec::new();
     for &balls in &args.sizes {
         let balls = balls as usize;
-        let grid = BenchCase {
+        let discrete = BenchCase {
             balls,
             steps: args.steps,
             broad_phase: BroadPhase::Grid,
+            collisions: CollisionMode::Discrete,
         };
         let all_pairs = (balls as u64 <= args.all_pairs_max).then_some(BenchCase {
             steps: (args.steps / 10).max(5),
             broad_phase: BroadPhase::AllPairs,
-            ..grid
+            ..discrete
         });
+        let continuous = BenchCase {
+            collisions: CollisionMode::Continuous,
+            ..discrete
+        };
         let row = BenchRow {
             balls,
-            one_core: run_case_in_child(grid, true)?,
-            all_cores: run_case_in_child(grid, false)?,
+            one_core: run_case_in_child(discrete, true)?,
+            all_cores: run_case_in_child(discrete, false)?,
             all_pairs: all_pairs
                 .map(|case| run_case_in_child(case, true))
                 .transpose()?,
+            continuous_one_core: run_case_in_child(continuous, true)?,
+            continuous_all_cores: run_case_in_child(continuous, false)?,
         };
         if !args.json {
             eprintln!("measured {balls} balls");
@@ -273,6 +314,7 @@ fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
         balls: args.balls as usize,
         steps: args.steps,
         broad_phase: args.broad_phase.into(),
+        collisions: args.collisions.into(),
     };
     println!(
         "{}",

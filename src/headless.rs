@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
 
+use crate::sim::gas::SpeedHistogram;
 use crate::sim::{
     Ball, BallId, Position, Radius, SceneSetup, SimParams, SimPlugin, SimStats, StateSummary,
     Velocity,
@@ -72,6 +73,8 @@ pub struct RunReport {
     pub kinetic_energy_change_rel: f64,
     pub mechanical_energy_start: f64,
     pub mechanical_energy_end: f64,
+    /// (end - start) / |start| of kinetic plus potential energy: the drift with gravity.
+    pub mechanical_energy_change_rel: f64,
     pub momentum_start: [f64; 2],
     pub momentum_end: [f64; 2],
     /// Largest remaining overlap at the end, divided by the smaller radius of the pair.
@@ -82,6 +85,10 @@ pub struct RunReport {
     pub pressure: f64,
     /// Mean kinetic energy per ball at the end.
     pub temperature: f64,
+    /// Ball speeds at the end, binned, against the 2-D Maxwell–Boltzmann expectation.
+    pub speed_histogram: SpeedHistogram,
+    /// Continuous steps that hit the per-ball hit limit (see `SimStats::cut_short_steps`).
+    pub cut_short_steps: u64,
 }
 
 impl RunReport {
@@ -138,12 +145,18 @@ pub fn run_scene_with_threads(
         kinetic_energy_change_rel: relative_change(start.kinetic_energy, end.kinetic_energy),
         mechanical_energy_start: start.mechanical_energy,
         mechanical_energy_end: end.mechanical_energy,
+        mechanical_energy_change_rel: relative_change(
+            start.mechanical_energy,
+            end.mechanical_energy,
+        ),
         momentum_start: start.momentum.to_array(),
         momentum_end: end.momentum.to_array(),
         max_overlap_rel: end.max_overlap_rel,
         escaped: end.escaped,
         pressure: stats.pressure(arena_size),
         temperature: end.temperature(),
+        speed_histogram: end.speed_histogram,
+        cut_short_steps: stats.cut_short_steps,
     };
     (app, report)
 }
@@ -170,11 +183,12 @@ fn mean(values: &[f64]) -> f64 {
     }
 }
 
+/// `(end - start) / |start|`, so a drop reads negative whatever the sign of `start`.
 fn relative_change(start: f64, end: f64) -> f64 {
     if start == 0.0 {
         0.0
     } else {
-        (end - start) / start
+        (end - start) / start.abs()
     }
 }
 

@@ -16,7 +16,7 @@ use bevy::window::{PrimaryWindow, WindowResolution};
 use rand::RngExt;
 
 use crate::render::{self, PlayArea};
-use crate::sim::{Ball, SceneFile, SimPlugin, SimRng};
+use crate::sim::{Ball, SceneFile, SimParams, SimPlugin, SimRng};
 use crate::{diagnostics, ui};
 
 /// Largest window the toy opens or resizes to, logical pixels.
@@ -33,6 +33,8 @@ pub struct PlayOptions {
     pub arena: Vec2,
     /// Save a PNG of the window after `frames` frames, then exit.
     pub screenshot: Option<(PathBuf, u32)>,
+    /// Start paused (Space or the Pause button runs it).
+    pub paused: bool,
 }
 
 /// The scene being played, as a file (so reset and reseed rebuild it), and its name.
@@ -75,6 +77,8 @@ pub fn play(options: PlayOptions) -> AppExit {
     }))
     .add_plugins(GamePlugin)
     .insert_resource(options.scene);
+    // Loading a scene keeps the pause state, so this survives the start-up load.
+    app.world_mut().resource_mut::<SimParams>().paused = options.paused;
     if let Some((path, frames)) = options.screenshot {
         app.insert_resource(ScreenshotPlan {
             path,

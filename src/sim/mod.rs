@@ -16,6 +16,7 @@ pub mod aim;
 pub mod ball;
 pub mod collision;
 pub mod continuous;
+pub mod gas;
 pub mod messages;
 pub mod movement;
 pub mod params;

@@ -12,6 +12,7 @@ use super::ball::{Ball, Position, Radius, Velocity};
 use super::collision::broad_phase::UniformGrid;
 use super::collision::narrow_phase::Circle;
 use super::collision::{IndexedContact, find_contacts};
+use super::gas::{SPEED_BINS, SpeedHistogram};
 use super::messages::{BallCollision, WallCollision};
 use super::params::{BroadPhase, SimParams};
 use super::{SimSystems, step_seconds};
@@ -106,6 +107,8 @@ pub struct StateSummary {
     pub max_overlap_rel: f64,
     /// Balls whose centre lies outside the arena.
     pub escaped: usize,
+    /// Ball speeds against the Maxwell–Boltzmann curve for their temperature.
+    pub speed_histogram: SpeedHistogram,
 }
 
 impl StateSummary {
@@ -124,6 +127,7 @@ impl StateSummary {
         let half = params.half_extents();
         let mut summary = StateSummary::default();
         let mut circles = Vec::new();
+        let mut speeds = Vec::new();
         let mut balls = world.query_filtered::<(&Position, &Velocity, &Radius), With<Ball>>();
         for (position, velocity, radius) in balls.iter(world) {
             let mass = params.mass_model.mass(radius.0);
@@ -136,7 +140,9 @@ impl StateSummary {
                 summary.escaped += 1;
             }
             circles.push(Circle::new(position.0, radius.0));
+            speeds.push((mass, velocity.length()));
         }
+        summary.speed_histogram = SpeedHistogram::measure(&speeds, SPEED_BINS);
         let mut contacts: Vec<IndexedContact> = Vec::new();
         find_contacts(
             &circles,

@@ -1,5 +1,6 @@
 //! The egui side panel: every tunable live (sliders, buttons, scene picker, overlays) and
-//! readouts (FPS, balls, collisions per second, energy, momentum, an energy plot). Edits go to
+//! readouts (FPS, balls, collisions per second, energy, momentum, an energy plot; the gas's
+//! temperature, pressure and speed histogram against the Maxwell–Boltzmann curve). Edits go to
 //! copies that are clamped to their limits and written back only when they changed. Runs in
 //! `EguiPrimaryContextPass`; [`Readouts`] are gathered in `Update`.
 
@@ -13,16 +14,18 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, RichText, Slider};
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
-use egui_plot::{Line, Plot, PlotPoints};
+use egui_plot::{Bar, BarChart, Line, Plot, PlotPoints};
 
 use super::PANEL_WIDTH;
 use crate::diagnostics::frame_figures;
 use crate::play::{CurrentScene, SceneLoaded, SceneRequest, SceneStatus};
 use crate::render::{ColourMode, PlayArea, ViewSettings};
+use crate::sim::gas::{SPEED_BINS, SpeedHistogram};
 use crate::sim::spawn::set_ball_count;
 use crate::sim::stats::kinetic_energy;
 use crate::sim::{
-    Ball, MassModel, PendingSteps, Radius, SimParams, SimStats, SpawnSettings, Velocity,
+    Ball, CollisionMode, MassModel, PendingSteps, Radius, SimParams, SimStats, SpawnSettings,
+    Velocity,
 };
 
 /// Where the scene picker looks for scene files, relative to the working directory.
@@ -93,10 +96,25 @@ pub struct Readouts {
     pub kinetic_energy: f64,
     pub momentum: DVec2,
     pub collisions_per_second: f64,
+    /// Mean kinetic energy per ball.
+    pub temperature: f64,
+    /// Wall impulse per unit length and time over the last [`RATE_WINDOW_SECONDS`].
+    pub pressure: f64,
+    pub speed_histogram: SpeedHistogram,
     /// (simulated seconds, kinetic energy) over the last [`PLOT_SECONDS`].
     pub energy_history: VecDeque<[f64; 2]>,
-    /// (simulated seconds, collisions so far) over the last [`RATE_WINDOW_SECONDS`].
-    collision_samples: VecDeque<(f64, u64)>,
+    /// Counters at moments within the last [`RATE_WINDOW_SECONDS`].
+    samples: VecDeque<CounterSample>,
+    /// (mass, speed) of every ball: the histogram's input, kept to reuse its memory.
+    speeds: Vec<(f64, f64)>,
+}
+
+/// [`SimStats`] counters at one moment, for rates over a window.
+#[derive(Clone, Copy, Debug)]
+struct CounterSample {
+    sim_time: f64,
+    ball_collisions: u64,
+    wall_impulse: f64,
 }
 
 fn update_readouts(
@@ -108,41 +126,54 @@ fn update_readouts(
 ) {
     let mass_model = params.mass_model;
     let (mut energy, mut momentum) = (0.0, DVec2::ZERO);
+    readouts.speeds.clear();
     for (velocity, radius) in &balls {
         let mass = mass_model.mass(radius.0);
         energy += kinetic_energy(mass, velocity.0);
         momentum += velocity.0 * mass;
+        readouts.speeds.push((mass, velocity.length()));
     }
     let now = stats.sim_time;
     let readouts = &mut *readouts;
     readouts.balls = balls.iter().len();
     readouts.kinetic_energy = energy;
     readouts.momentum = momentum;
+    readouts.temperature = if readouts.balls > 0 {
+        energy / readouts.balls as f64
+    } else {
+        0.0
+    };
+    readouts.speed_histogram = SpeedHistogram::measure(&readouts.speeds, SPEED_BINS);
     if loaded.read().count() > 0 {
-        readouts.collision_samples.clear();
+        readouts.samples.clear();
         readouts.energy_history.clear();
     }
-    if readouts
-        .collision_samples
-        .back()
-        .is_none_or(|&(t, _)| t < now)
-    {
-        readouts
-            .collision_samples
-            .push_back((now, stats.ball_collisions));
+    if readouts.samples.back().is_none_or(|s| s.sim_time < now) {
+        readouts.samples.push_back(CounterSample {
+            sim_time: now,
+            ball_collisions: stats.ball_collisions,
+            wall_impulse: stats.wall_impulse,
+        });
     }
-    while readouts.collision_samples.len() > 2
-        && readouts.collision_samples[1].0 <= now - RATE_WINDOW_SECONDS
-    {
-        readouts.collision_samples.pop_front();
+    while readouts.samples.len() > 2 && readouts.samples[1].sim_time <= now - RATE_WINDOW_SECONDS {
+        readouts.samples.pop_front();
     }
-    readouts.collisions_per_second = match (
-        readouts.collision_samples.front(),
-        readouts.collision_samples.back(),
-    ) {
-        (Some(&(t0, c0)), Some(&(t1, c1))) if t1 > t0 => (c1 - c0) as f64 / (t1 - t0),
-        _ => 0.0,
-    };
+    (readouts.collisions_per_second, readouts.pressure) =
+        match (readouts.samples.front(), readouts.samples.back()) {
+            (Some(first), Some(last)) if last.sim_time > first.sim_time => {
+                let elapsed = last.sim_time - first.sim_time;
+                let perimeter = 2.0 * (params.arena_size.x + params.arena_size.y);
+                (
+                    (last.ball_collisions - first.ball_collisions) as f64 / elapsed,
+                    if perimeter > 0.0 {
+                        (last.wall_impulse - first.wall_impulse) / (perimeter * elapsed)
+                    } else {
+                        0.0
+                    },
+                )
+            }
+            _ => (0.0, 0.0),
+        };
     if readouts
         .energy_history
         .back()
@@ -225,8 +256,9 @@ fn draw_panel(
                 controls(ui, &mut tunables, &shown, &mut requests);
                 balls(ui, &mut tunables.spawn, &shown.readouts, &mut commands);
                 physics(ui, &mut tunables);
-                view(ui, &mut tunables.view);
                 readouts(ui, &shown);
+                gas(ui, &shown.readouts);
+                view(ui, &mut tunables.view);
             });
         });
     Ok(())
@@ -326,6 +358,20 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
         .default_open(true)
         .show(ui, |ui| {
             let mut edited = tunables.params.clone();
+            ui.horizontal(|ui| {
+                ui.label("collisions");
+                for (mode, name) in CollisionMode::ALL
+                    .into_iter()
+                    .zip(["continuous", "discrete"])
+                {
+                    ui.radio_value(&mut edited.collisions, mode, name);
+                }
+            })
+            .response
+            .on_hover_text(
+                "continuous: every impact at its exact moment, nothing tunnels\n\
+                 discrete: the tutorial's move, find overlaps, respond, separate",
+            );
             ui.add(Slider::new(&mut edited.gravity.x, GRAVITY_SLIDER).text("gravity x"));
             ui.add(Slider::new(&mut edited.gravity.y, GRAVITY_SLIDER).text("gravity y"));
             ui.add(Slider::new(&mut edited.restitution, 0.0..=1.0).text("restitution"));
@@ -360,7 +406,7 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
 
 fn view(ui: &mut egui::Ui, view: &mut ViewSettings) {
     egui::CollapsingHeader::new("View")
-        .default_open(true)
+        .default_open(false)
         .show(ui, |ui| {
             let mut edited = view.clone();
             ui.horizontal(|ui| {
@@ -408,7 +454,7 @@ fn readouts(ui: &mut egui::Ui, shown: &Shown) {
             });
             let points: PlotPoints = r.energy_history.iter().copied().collect();
             Plot::new("energy-plot")
-                .height(110.0)
+                .height(90.0)
                 .include_y(0.0)
                 .allow_drag(false)
                 .allow_zoom(false)
@@ -416,5 +462,57 @@ fn readouts(ui: &mut egui::Ui, shown: &Shown) {
                 .allow_boxed_zoom(false)
                 .x_axis_label("simulated s")
                 .show(ui, |plot| plot.line(Line::new("kinetic energy", points)));
+        });
+}
+
+/// Temperature, pressure and the speed histogram against the Maxwell–Boltzmann curve.
+fn gas(ui: &mut egui::Ui, readouts: &Readouts) {
+    egui::CollapsingHeader::new("Gas")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::Grid::new("gas").num_columns(2).show(ui, |ui| {
+                for (name, value) in [
+                    ("temperature", format!("{:.4e}", readouts.temperature)),
+                    ("pressure", format!("{:.4e}", readouts.pressure)),
+                ] {
+                    ui.label(name);
+                    ui.monospace(value);
+                    ui.end_row();
+                }
+            });
+            let histogram = &readouts.speed_histogram;
+            let width = histogram.bin_width;
+            let bars = histogram
+                .counts
+                .iter()
+                .enumerate()
+                .map(|(bin, &count)| {
+                    Bar::new((bin as f64 + 0.5) * width, count as f64).width(width)
+                })
+                .collect();
+            let curve: PlotPoints = histogram
+                .expected
+                .iter()
+                .enumerate()
+                .map(|(bin, &expected)| [(bin as f64 + 0.5) * width, expected])
+                .collect();
+            Plot::new("speed-histogram")
+                .height(120.0)
+                .include_y(0.0)
+                .allow_drag(false)
+                .allow_zoom(false)
+                .allow_scroll(false)
+                .allow_boxed_zoom(false)
+                .x_axis_label("speed px/s")
+                .show(ui, |plot| {
+                    plot.bar_chart(
+                        BarChart::new("balls", bars).color(Color32::from_rgb(90, 140, 220)),
+                    );
+                    plot.line(
+                        Line::new("Maxwell–Boltzmann", curve)
+                            .color(Color32::from_rgb(240, 170, 60))
+                            .width(2.0),
+                    );
+                });
         });
 }

@@ -21,7 +21,7 @@ fn ballpit_ok(args: &[&str]) -> Output {
     out
 }
 
-const REPORT_FIELDS: [&str; 16] = [
+const REPORT_FIELDS: [&str; 19] = [
     "steps",
     "sim_time_s",
     "ms_per_step_median",
@@ -38,6 +38,9 @@ const REPORT_FIELDS: [&str; 16] = [
     "temperature",
     "balls",
     "dt_s",
+    "mechanical_energy_change_rel",
+    "speed_histogram",
+    "cut_short_steps",
 ];
 
 #[test]
@@ -149,6 +152,15 @@ fn usage_errors_exit_2() {
             "3",
             "--bogus",
         ],
+        &[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "3",
+            "--collisions",
+            "sideways",
+        ],
     ] {
         let out = ballpit(args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -220,4 +232,35 @@ fn the_same_run_with_one_thread_or_three_is_bit_identical() {
     assert!(one.len() > 1_000_000);
     assert!(one == three, "the dumps differ");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn collisions_flag_chooses_the_mode_and_discrete_overlaps_where_continuous_does_not() {
+    let run = |mode: &str| {
+        let out = ballpit_ok(&[
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "60",
+            "--balls",
+            "300",
+            "--collisions",
+            mode,
+            "--json",
+        ]);
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (continuous, discrete) = (run("continuous"), run("discrete"));
+    assert_eq!(continuous["max_overlap_rel"].as_f64(), Some(0.0));
+    assert!(discrete["max_overlap_rel"].as_f64().unwrap() > 0.01);
+    let histogram = &continuous["speed_histogram"];
+    let counts: u64 = histogram["counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_u64().unwrap())
+        .sum();
+    assert_eq!(counts, 300);
+    assert_eq!(histogram["expected"].as_array().unwrap().len(), 40);
 }

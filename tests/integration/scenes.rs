@@ -33,6 +33,7 @@ fn every_shipped_scene_loads() {
         "billiards.ron",
         "gas.ron",
         "head_on.ron",
+        "maxwell.ron",
         "newtons_cradle.ron",
         "tutorial.ron",
     ] {
@@ -196,4 +197,34 @@ fn missing_file_names_the_file() {
         error.starts_with("no/such/scene.ron: cannot read"),
         "{error}"
     );
+}
+
+#[test]
+fn a_scene_may_choose_its_collision_mode() {
+    let scene = SceneFile::parse(
+        "(collisions: Discrete, balls: [(position: (0.0, 0.0), radius: 5.0)])",
+        "mode.ron",
+    )
+    .unwrap();
+    let setup = scene.build("mode.ron").unwrap();
+    assert_eq!(setup.collisions, Some(CollisionMode::Discrete));
+    let mut app = headless_app(1.0 / 60.0);
+    setup.apply(app.world_mut());
+    assert_eq!(
+        app.world().resource::<SimParams>().collisions,
+        CollisionMode::Discrete
+    );
+    // Without the field the mode in use is kept.
+    let plain = SceneFile::parse(
+        "(balls: [(position: (0.0, 0.0), radius: 5.0)])",
+        "plain.ron",
+    )
+    .unwrap();
+    plain.build("plain.ron").unwrap().apply(app.world_mut());
+    assert_eq!(
+        app.world().resource::<SimParams>().collisions,
+        CollisionMode::Discrete
+    );
+    let error = SceneFile::parse("(\n  collisions: Sideways,\n)", "bad.ron").unwrap_err();
+    assert!(error.to_string().starts_with("bad.ron:2:"), "{error}");
 }
