@@ -1,5 +1,7 @@
 //! `ballpit bench`: the standard gas (`assets/scenes/gas.ron`: radius U[5, 15] px, speed
-//! U[0, 500] px/s, area fraction 0.30, dt 1/60 s) at several sizes, with figures per size.
+//! U[0, 500] px/s, area fraction 0.30, dt 1/60 s) at several sizes, with figures per size: the
+//! discrete mode on one core, two cores and against all pairs, then the continuous mode
+//! against the discrete one.
 //!
 //! Each case runs in a child process (`ballpit bench-one`), so its peak memory is its own and
 //! its core count can be set: one-core cases are started under `taskset -c 0`, which Bevy's

@@ -542,6 +542,8 @@ impl Timeline {
         spec: StepSpec,
     ) {
         if self.hits[index] == MAX_HITS_PER_BALL {
+            // No more impacts for this ball this step: the end-of-step fallback takes over.
+            self.cut_short = true;
             return;
         }
         let (circle, velocity) = (circles[index], velocities[index]);
@@ -756,4 +758,101 @@ fn run_timeline(
     write_back(entities, &mut balls, |index| {
         Some((circles[index].center, velocities[index]))
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HALF: DVec2 = DVec2::new(100.0, 50.0);
+
+    #[test]
+    fn wall_time_is_the_gap_over_the_speed_toward_the_nearer_wall() {
+        // 90 px to the right wall's limit at 30 px/s; 40 px to the top at 10 px/s.
+        let (time, wall) =
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(30.0, 10.0), 10.0, HALF).unwrap();
+        assert_eq!((time, wall), (3.0, Wall::Right));
+        let (time, wall) =
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(-1.0, -20.0), 10.0, HALF).unwrap();
+        assert_eq!((time, wall), (2.0, Wall::Bottom));
+        // Already through a wall and still moving into it: now. Moving away: never.
+        let past = DVec2::new(95.0, 0.0);
+        assert_eq!(
+            wall_time_of_impact(past, DVec2::X, 10.0, HALF),
+            Some((0.0, Wall::Right))
+        );
+        assert_eq!(
+            wall_time_of_impact(past, DVec2::NEG_X, 10.0, HALF).map(|h| h.1),
+            Some(Wall::Left)
+        );
+        assert_eq!(
+            wall_time_of_impact(DVec2::ZERO, DVec2::ZERO, 10.0, HALF),
+            None
+        );
+        // Wider than the arena along y: only x counts.
+        assert_eq!(
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(0.0, 5.0), 60.0, HALF),
+            None
+        );
+    }
+
+    #[test]
+    fn impacts_come_out_by_time_then_by_ball() {
+        let impact = |time, a, other| Impact {
+            time,
+            a,
+            other,
+            hits_a: 0,
+            hits_other: 0,
+        };
+        let mut queue: BinaryHeap<Reverse<Impact>> = [
+            impact(0.5, 3, 4),
+            impact(0.25, 7, 9),
+            impact(0.5, 1, 8),
+            impact(0.5, 1, 2),
+        ]
+        .into_iter()
+        .map(Reverse)
+        .collect();
+        let order: Vec<(u32, u32)> =
+            std::iter::from_fn(|| queue.pop().map(|Reverse(i)| (i.a, i.other))).collect();
+        assert_eq!(order, [(7, 9), (1, 2), (1, 8), (3, 4)]);
+    }
+
+    #[test]
+    fn a_timeline_on_plain_arrays_bounces_a_fast_pair_and_keeps_energy() {
+        let spec = StepSpec {
+            dt: 1.0,
+            half: DVec2::new(1_000.0, 1_000.0),
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+        };
+        let mut circles = vec![
+            Circle::new(DVec2::new(-100.0, 0.0), 5.0),
+            Circle::new(DVec2::new(100.0, 3.0), 10.0),
+        ];
+        let mut velocities = vec![DVec2::new(300.0, 0.0), DVec2::new(-300.0, 0.0)];
+        let energy = |v: &[DVec2], c: &[Circle]| -> f64 {
+            v.iter()
+                .zip(c)
+                .map(|(v, c)| 0.5 * c.radius * v.length_squared())
+                .sum()
+        };
+        let before = energy(&velocities, &circles);
+        let mut timeline = Timeline::default();
+        timeline.predict(&circles, &velocities, spec);
+        let mut hits = Vec::new();
+        timeline.run(&mut circles, &mut velocities, spec, |hit| hits.push(hit));
+        assert_eq!(hits.len(), 1);
+        let Hit::Ball { time, point, .. } = hits[0] else {
+            panic!("a ball hit")
+        };
+        // Closing 600 px/s over 200 - sqrt(15^2 - 3^2) px.
+        let expected = (200.0 - (15.0f64 * 15.0 - 9.0).sqrt()) / 600.0;
+        assert!((time - expected).abs() < 1e-12, "{time} vs {expected}");
+        assert!(point.x.abs() < 15.0);
+        assert!((energy(&velocities, &circles) - before).abs() < 1e-9 * before);
+        assert!(circles[0].center.distance(circles[1].center) >= 15.0 - 1e-9);
+        assert!(velocities[0].x < 0.0 && velocities[1].x > 0.0);
+    }
 }

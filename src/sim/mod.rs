@@ -2,15 +2,21 @@
 //! no window, asset, render or egui resource, so it runs under `MinimalPlugins` in tests, on
 //! the command line and in benchmarks exactly as it does in the game.
 //!
-//! One fixed step, in `FixedUpdate`, is four ordered sets (chained once, below):
+//! One fixed step, in `FixedUpdate`, is four ordered sets (chained once, below).
+//! [`SimParams::collisions`] chooses the systems of stages 2 and 3:
 //!
-//! 1. [`SimSystems::Movement`]: integrate velocity and position; bounce off the walls.
-//! 2. [`SimSystems::Collision`]: broad phase (grid), AABB test, exact distance test → [`Contacts`].
-//! 3. [`SimSystems::Response`]: elastic exchange along each contact normal, separation, walls.
+//! 1. [`SimSystems::Movement`]: integrate velocity (and, in discrete mode, position and the
+//!    walls); copy every ball into the contiguous [`BallSnapshot`](ball::BallSnapshot).
+//! 2. [`SimSystems::Collision`]: discrete, broad phase (grid), AABB test, exact distance test →
+//!    [`Contacts`] (`collision`); continuous, the exact time of impact of every approaching
+//!    pair and wall within the step (`continuous`).
+//! 3. [`SimSystems::Response`]: discrete, exchange along each contact normal, separation, walls
+//!    (`response`); continuous, the impacts in time order, predicting anew after each
+//!    (`continuous`). Either writes the balls back.
 //! 4. [`SimSystems::Bookkeeping`]: counters from the collision messages; debug invariants.
 //!
-//! Data flows one way: components → contacts → components, and outward as
-//! [`BallCollision`] / [`WallCollision`] messages.
+//! Data flows one way: components → snapshot → contacts or impacts → components, and outward
+//! as [`BallCollision`] / [`WallCollision`] messages.
 
 pub mod aim;
 pub mod ball;
@@ -42,9 +48,10 @@ pub use stats::{SimStats, StateSummary};
 pub enum SimSystems {
     /// Integrate motion and keep balls inside the arena.
     Movement,
-    /// Find touching pairs: broad phase, AABB test, exact test.
+    /// Find touching pairs (discrete) or predict the step's impacts (continuous).
     Collision,
-    /// Exchange momentum along contact normals and separate overlapping pairs.
+    /// Exchange momentum along contact normals and separate overlapping pairs (discrete), or
+    /// handle the impacts in time order (continuous).
     Response,
     /// Count steps and collisions; check invariants in debug builds.
     Bookkeeping,

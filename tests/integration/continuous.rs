@@ -233,3 +233,23 @@ fn equal_speeds_relax_onto_the_maxwell_boltzmann_curve() {
     let temperature_change = end.temperature() / start.temperature() - 1.0;
     assert!(temperature_change.abs() < 1e-9, "{temperature_change}");
 }
+
+#[test]
+fn a_collapsing_pile_is_cut_short_yet_stays_finite_and_inside() {
+    // Strong gravity and restitution 0.5 press the gas into a pile where impacts repeat ever
+    // faster: steps reach the per-ball hit limit and finish with the discrete fallback.
+    let setup = shipped_scene("gas.ron").build("gas.ron").unwrap();
+    let mut params = setup.params.clone();
+    params.gravity = DVec2::new(300.0, -2000.0);
+    params.restitution = 0.5;
+    params.collisions = CollisionMode::Continuous;
+    let half = params.half_extents();
+    let mut app = app_with(params, &setup.balls);
+    step(&mut app, 90);
+    assert!(app.world().resource::<SimStats>().cut_short_steps > 0);
+    for b in states(&mut app) {
+        assert!(b.position.is_finite() && b.velocity.is_finite());
+        let reach = b.position.abs() + DVec2::splat(b.radius);
+        assert!(reach.x <= half.x + 1e-9 && reach.y <= half.y + 1e-9);
+    }
+}
