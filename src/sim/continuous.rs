@@ -3,11 +3,11 @@
 //! In continuous mode the movement stage only updates velocities (gravity, damping), so every
 //! ball's path over the step is a straight segment. Then:
 //!
-//! - **Collision** ([`predict_impacts`], in [`SimSystems::Collision`]): the circles swept
+//! - **Collision** (`predict_impacts`, in [`SimSystems::Collision`]): the circles swept
 //!   along those segments go into the grid; their AABBs and distances cut the candidate
 //!   pairs, and the exact quadratic ([`time_of_impact`]) gives each approaching pair's moment
 //!   of contact. Each ball's first wall contact is found the same way.
-//! - **Response** ([`run_timeline`], in [`SimSystems::Response`]): take the earliest impact,
+//! - **Response** (`run_timeline`, in [`SimSystems::Response`]): take the earliest impact,
 //!   move just its balls to that moment, exchange momentum along the line of centres (or
 //!   reflect off the wall), predict anew for those balls, and repeat until the step is over;
 //!   then move every ball to the end of the step and write them back.

@@ -98,10 +98,10 @@ pub struct Readouts {
     pub collisions_per_second: f64,
     /// Mean kinetic energy per ball.
     pub temperature: f64,
-    /// Wall impulse per unit length and time over the last [`RATE_WINDOW_SECONDS`].
+    /// Wall impulse per unit length and time over the last simulated second.
     pub pressure: f64,
     pub speed_histogram: SpeedHistogram,
-    /// (simulated seconds, kinetic energy) over the last [`PLOT_SECONDS`].
+    /// (simulated seconds, kinetic energy) over the last 10 simulated seconds.
     pub energy_history: VecDeque<[f64; 2]>,
     /// Counters at moments within the last [`RATE_WINDOW_SECONDS`].
     samples: VecDeque<CounterSample>,

@@ -1,6 +1,7 @@
 //! Broad phase: which pairs of balls might touch, before the exact test.
 //!
-//! Runs inside [`detect_contacts`](super::detect_contacts). Two methods find the same pairs:
+//! Runs inside the collision stage (`detect_contacts`, and the continuous mode's impact
+//! prediction, which sorts swept circles and also queries boxes). Two methods find the same pairs:
 //! [`UniformGrid`], O(N), the default, and [`for_each_pair`], O(N^2), kept as the reference the
 //! grid is tested against.
 

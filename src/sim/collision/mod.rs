@@ -91,7 +91,7 @@ pub fn find_contacts(
 
 /// Runs `search(grid, rows, out)` over bands of the grid's rows and appends what the bands
 /// find to `found` in row order, so the result does not depend on the thread count. The bands
-/// run in parallel on the compute pool once the grid holds [`PARALLEL_MIN_BALLS`] balls.
+/// run in parallel on the compute pool once the grid holds `PARALLEL_MIN_BALLS` (20,000) balls.
 pub fn search_in_bands<T: Send + 'static>(
     grid: &UniformGrid,
     found: &mut Vec<T>,

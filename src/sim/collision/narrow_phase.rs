@@ -1,6 +1,6 @@
 //! Narrow phase: the exact circle–circle tests, as pure functions over plain values.
 //!
-//! Runs inside [`detect_contacts`](super::detect_contacts) for every candidate pair the broad
+//! Runs inside the collision stage (`detect_contacts`) for every candidate pair the broad
 //! phase proposes, and again wherever a prediction must match the simulation exactly (tests,
 //! the aiming guide).
 
