@@ -28,10 +28,20 @@ fn head_on_at_20_diameters_per_step_bounces_where_discrete_tunnels() {
         ball(100.0, 0.0, -v, 0.0, 5.0),
     ];
     let mut app = app_with(params(CollisionMode::Continuous, 2000.0, 200.0), &balls);
+    record_collisions(&mut app);
     step(&mut app, 1);
     let [a, b] = states(&mut app)[..] else {
         panic!("two balls")
     };
+    // The message carries the true moment and point of contact.
+    let hits = &app.world().resource::<Recorded>().ball_hits;
+    assert_eq!(hits.len(), 1);
+    assert!((hits[0].time - 0.475 * DT).abs() < 1e-9, "{}", hits[0].time);
+    assert!(
+        hits[0].point.distance(DVec2::ZERO) < 1e-5,
+        "{}",
+        hits[0].point
+    );
     // They close 400 px a step over a 190 px gap: contact at 0.475 of the step at x = -5 and
     // 5; equal masses swap velocities and travel back for the remaining 0.525 step (105 px).
     // (The fixed step is 1/60 s rounded to whole nanoseconds: 4e-6 px over the step.)
