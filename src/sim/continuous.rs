@@ -13,7 +13,7 @@
 //!   then move every ball to the end of the step and write them back.
 //!
 //! The [`Timeline`] does the work on plain arrays, so it is tested without an app. Balls move
-//! lazily: `circles[i]` holds ball `i` where it was `clock[i]` seconds into the step. An
+//! lazily: each remembers where it was at the moment of its last hit. An
 //! impact remembers how many hits each of its balls had when it was predicted; if either has
 //! been hit since, the prediction is stale and skipped.
 //!
@@ -64,7 +64,7 @@ pub const MIN_APPROACH_SPEED: f64 = 1e-9;
 /// pressed together by gravity, restitution below 1) comes near it; the step then ends for
 /// that ball without further impacts, and the overlaps left at the end get the discrete
 /// mode's response. [`SimStats::cut_short_steps`] counts such steps.
-pub const MAX_HITS_PER_BALL: u32 = 8;
+pub const MAX_HITS_PER_BALL: u32 = 16;
 /// Pairs overlapping by more than this fraction of their summed radii at the start of a step
 /// (placed so, or left by a discrete step or a cut-short one) are pushed apart at its end.
 const OVERLAP_TOLERANCE: f64 = 1e-9;
@@ -160,6 +160,10 @@ fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2) -> 
     time_of_impact(a, velocity_a, b, velocity_b)
 }
 
+/// Pixels added to a redirected ball's swept circle, so rounding can never make the swept
+/// circles' test reject a pair that touches at the very edge of the step.
+const SWEPT_MARGIN: f64 = 1e-6;
+
 /// `other` values from here up name a wall, below it a ball.
 const WALL_BASE: u32 = u32::MAX - 3;
 const WALLS: [Wall; 4] = [Wall::Left, Wall::Right, Wall::Bottom, Wall::Top];
@@ -227,6 +231,8 @@ struct RerouteEntry {
     ball: u32,
     hits: u32,
     next: u32,
+    /// The circle the rest of the ball's path sweeps.
+    swept: Circle,
 }
 
 impl Rerouted {
@@ -245,7 +251,7 @@ impl Rerouted {
         self.reach = 0.0;
     }
 
-    fn insert(&mut self, cell: usize, ball: u32, hits: u32, reach: f64) {
+    fn insert(&mut self, cell: usize, ball: u32, hits: u32, swept: Circle) {
         if self.head[cell] == Self::NONE {
             self.used_cells.push(cell as u32);
         }
@@ -253,32 +259,62 @@ impl Rerouted {
             ball,
             hits,
             next: self.head[cell],
+            swept,
         });
         self.head[cell] = (self.entries.len() - 1) as u32;
-        self.reach = self.reach.max(reach);
+        self.reach = self.reach.max(swept.radius);
     }
 
-    /// Visits the balls whose current entry is in `cells`.
+    /// Calls `visit(ball, swept)` for the balls whose current entry is in `cells`.
     fn for_each_in_cells(
         &self,
         cells: std::ops::Range<usize>,
-        hits: &[u32],
-        mut visit: impl FnMut(u32),
+        movers: &[Mover],
+        mut visit: impl FnMut(u32, Circle),
     ) {
         for cell in cells {
             let mut entry = self.head[cell];
             while entry != Self::NONE {
                 let RerouteEntry {
                     ball,
-                    hits: filed,
+                    hits,
                     next,
+                    swept,
                 } = self.entries[entry as usize];
-                if hits[ball as usize] == filed {
-                    visit(ball);
+                if movers[ball as usize].hits == hits {
+                    visit(ball, swept);
                 }
                 entry = next;
             }
         }
+    }
+}
+
+/// A ball on the step's timeline: where it is `clock` seconds into the step, and how many hits
+/// it has taken.
+#[derive(Clone, Copy, Debug)]
+struct Mover {
+    center: DVec2,
+    velocity: DVec2,
+    radius: f64,
+    clock: f64,
+    hits: u32,
+}
+
+impl Mover {
+    fn circle(&self) -> Circle {
+        Circle::new(self.center, self.radius)
+    }
+
+    /// Where the ball is `time` seconds into the step.
+    #[inline]
+    fn center_at(&self, time: f64) -> DVec2 {
+        self.center + self.velocity * (time - self.clock)
+    }
+
+    fn advance(&mut self, time: f64) {
+        self.center = self.center_at(time);
+        self.clock = time;
     }
 }
 
@@ -293,10 +329,9 @@ pub struct Timeline {
     predictions: Vec<Prediction>,
     queue: BinaryHeap<Reverse<Impact>>,
     overlapping: Vec<(u32, u32)>,
-    /// Seconds into the step at which each ball's circle is current.
-    clock: Vec<f64>,
-    /// Hits each ball has had this step.
-    hits: Vec<u32>,
+    /// Every ball on this step's timeline, by index: all a prediction reads of one ball in
+    /// one cache line.
+    movers: Vec<Mover>,
     rerouted: Rerouted,
     /// Contacts for the discrete response of a step cut short.
     fallback: Vec<IndexedContact>,
@@ -374,11 +409,19 @@ impl Timeline {
         spec: StepSpec,
         mut on_hit: impl FnMut(Hit),
     ) {
-        let count = circles.len();
-        self.clock.clear();
-        self.clock.resize(count, 0.0);
-        self.hits.clear();
-        self.hits.resize(count, 0);
+        self.movers.clear();
+        self.movers.extend(
+            circles
+                .iter()
+                .zip(velocities.iter())
+                .map(|(circle, velocity)| Mover {
+                    center: circle.center,
+                    velocity: *velocity,
+                    radius: circle.radius,
+                    clock: 0.0,
+                    hits: 0,
+                }),
+        );
         self.rerouted.reset(self.grid.cell_count());
         self.queue.clear();
         self.overlapping.clear();
@@ -393,23 +436,28 @@ impl Timeline {
         while let Some(Reverse(impact)) = self.queue.pop() {
             let a = impact.a as usize;
             let is_wall = impact.other >= WALL_BASE;
-            if self.hits[a] != impact.hits_a
-                || (!is_wall && self.hits[impact.other as usize] != impact.hits_other)
-            {
+            let hits_other = if is_wall {
+                0
+            } else {
+                self.movers[impact.other as usize].hits
+            };
+            if self.movers[a].hits != impact.hits_a || hits_other != impact.hits_other {
                 continue; // stale: a ball in it has been hit since
             }
-            if self.hits[a] == MAX_HITS_PER_BALL
-                || (!is_wall && self.hits[impact.other as usize] == MAX_HITS_PER_BALL)
-            {
+            if self.movers[a].hits == MAX_HITS_PER_BALL || hits_other == MAX_HITS_PER_BALL {
                 self.cut_short = true;
                 continue;
             }
             let now = impact.time;
-            self.advance(circles, velocities, a, now);
+            self.movers[a].advance(now);
             if is_wall {
                 let wall = WALLS[(impact.other - WALL_BASE) as usize];
-                if let Some(bounce) = bounce_off_wall(circles[a], &mut velocities[a], wall, spec) {
-                    circles[a].center = bounce.center;
+                let mover = &mut self.movers[a];
+                if let Some(bounce) =
+                    bounce_off_wall(mover.circle(), &mut mover.velocity, wall, spec)
+                {
+                    mover.center = bounce.center;
+                    mover.hits += 1;
                     on_hit(Hit::Wall {
                         ball: impact.a,
                         wall,
@@ -418,55 +466,55 @@ impl Timeline {
                         impulse: bounce.impulse,
                         normal_speed: bounce.normal_speed,
                     });
-                    self.hits[a] += 1;
                     self.handled += 1;
-                    self.predict_for(circles, velocities, a, now, spec);
+                    self.predict_for(a, now, spec);
                 }
             } else {
                 let b = impact.other as usize;
-                self.advance(circles, velocities, b, now);
-                let (ca, cb) = (circles[a], circles[b]);
-                let offset = cb.center - ca.center;
+                self.movers[b].advance(now);
+                let (ma, mb) = (self.movers[a], self.movers[b]);
+                let offset = mb.center - ma.center;
                 let distance = offset.length();
                 let normal = if distance > 0.0 {
                     offset / distance
                 } else {
                     COINCIDENT_NORMAL
                 };
-                let (inverse_mass_a, inverse_mass_b) = (
-                    spec.mass_model.inverse_mass(ca.radius),
-                    spec.mass_model.inverse_mass(cb.radius),
-                );
                 let Some(exchange) = normal_exchange(
-                    velocities[a],
-                    velocities[b],
-                    inverse_mass_a,
-                    inverse_mass_b,
+                    ma.velocity,
+                    mb.velocity,
+                    spec.mass_model.inverse_mass(ma.radius),
+                    spec.mass_model.inverse_mass(mb.radius),
                     normal,
                     spec.restitution,
                 ) else {
                     continue;
                 };
-                velocities[a] = exchange.velocity_a;
-                velocities[b] = exchange.velocity_b;
+                self.movers[a].velocity = exchange.velocity_a;
+                self.movers[b].velocity = exchange.velocity_b;
+                self.movers[a].hits += 1;
+                self.movers[b].hits += 1;
                 on_hit(Hit::Ball {
                     a: impact.a,
                     b: impact.other,
                     time: now,
-                    point: collision_point(ca, cb),
+                    point: collision_point(ma.circle(), mb.circle()),
                     normal,
                     impulse: exchange.impulse,
                     closing_speed: exchange.closing_speed,
                 });
-                self.hits[a] += 1;
-                self.hits[b] += 1;
                 self.handled += 1;
-                self.predict_for(circles, velocities, a, now, spec);
-                self.predict_for(circles, velocities, b, now, spec);
+                self.predict_for(a, now, spec);
+                self.predict_for(b, now, spec);
             }
         }
-        for index in 0..count {
-            self.advance(circles, velocities, index, spec.dt);
+        for ((circle, velocity), mover) in circles
+            .iter_mut()
+            .zip(velocities.iter_mut())
+            .zip(&mut self.movers)
+        {
+            mover.advance(spec.dt);
+            (circle.center, *velocity) = (mover.center, mover.velocity);
         }
         if self.cut_short {
             // Some balls stopped taking hits: whatever overlaps now gets the discrete response.
@@ -525,29 +573,15 @@ impl Timeline {
         }
     }
 
-    /// Moves ball `index` along its path to `time` seconds into the step.
-    #[inline]
-    fn advance(&mut self, circles: &mut [Circle], velocities: &[DVec2], index: usize, time: f64) {
-        circles[index].center += velocities[index] * (time - self.clock[index]);
-        self.clock[index] = time;
-    }
-
     /// Queues ball `index`'s next wall and ball impacts after its velocity changed at `now`.
-    fn predict_for(
-        &mut self,
-        circles: &[Circle],
-        velocities: &[DVec2],
-        index: usize,
-        now: f64,
-        spec: StepSpec,
-    ) {
-        if self.hits[index] == MAX_HITS_PER_BALL {
+    fn predict_for(&mut self, index: usize, now: f64, spec: StepSpec) {
+        let mover = self.movers[index];
+        if mover.hits == MAX_HITS_PER_BALL {
             // No more impacts for this ball this step: the end-of-step fallback takes over.
             self.cut_short = true;
             return;
         }
-        let (circle, velocity) = (circles[index], velocities[index]);
-        let hits = &self.hits;
+        let (circle, velocity) = (mover.circle(), mover.velocity);
         let queue = &mut self.queue;
         if let Some((time, wall)) =
             wall_time_of_impact(circle.center, velocity, circle.radius, spec.half)
@@ -557,33 +591,30 @@ impl Timeline {
                 time: now + time,
                 a: index as u32,
                 other: WALL_BASE + wall as u32,
-                hits_a: hits[index],
+                hits_a: mover.hits,
                 hits_other: 0,
             }));
         }
         let rest = spec.dt - now;
         let swept = Circle::new(
             circle.center + velocity * (0.5 * rest),
-            circle.radius + velocity.length() * (0.5 * rest),
+            circle.radius + velocity.length() * (0.5 * rest) + SWEPT_MARGIN,
         );
         self.rerouted.insert(
             self.grid.cell_index(swept.center),
             index as u32,
-            self.hits[index],
-            swept.radius,
+            mover.hits,
+            swept,
         );
-        let clock = &self.clock;
+        let movers = &self.movers;
         let mut consider = |other: u32| {
             let other_index = other as usize;
             if other_index == index {
                 return;
             }
-            let elapsed = now - clock[other_index];
-            let other_circle = Circle::new(
-                circles[other_index].center + velocities[other_index] * elapsed,
-                circles[other_index].radius,
-            );
-            let Some(time) = approach_time(circle, velocity, other_circle, velocities[other_index])
+            let other_mover = &movers[other_index];
+            let other_circle = Circle::new(other_mover.center_at(now), other_mover.radius);
+            let Some(time) = approach_time(circle, velocity, other_circle, other_mover.velocity)
                 .map(|t| now + t)
                 .filter(|&t| t <= spec.dt)
             else {
@@ -598,18 +629,19 @@ impl Timeline {
                 time,
                 a: a as u32,
                 other: b as u32,
-                hits_a: hits[a],
-                hits_other: hits[b],
+                hits_a: movers[a].hits,
+                hits_other: movers[b].hits,
             }));
         };
         // Balls on their first path of the step are filed in the grid by the circle that path
-        // sweeps; the ones that changed course since, in `rerouted`.
+        // sweeps; the ones that changed course since, in `rerouted`. Both filters are the
+        // swept circles: if they do not touch, neither can the balls.
         let near = DVec2::splat(swept.radius + self.grid_reach);
         self.grid.for_each_near(
             swept.center - near,
             swept.center + near,
             |other, other_swept| {
-                if hits[other as usize] == 0 && circles_touch(swept, other_swept) {
+                if movers[other as usize].hits == 0 && circles_touch(swept, other_swept) {
                     consider(other);
                 }
             },
@@ -618,7 +650,11 @@ impl Timeline {
         let rerouted = &self.rerouted;
         self.grid
             .for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
-                rerouted.for_each_in_cells(cells, hits, &mut consider);
+                rerouted.for_each_in_cells(cells, movers, |other, other_swept| {
+                    if circles_touch(swept, other_swept) {
+                        consider(other);
+                    }
+                });
             });
     }
 
