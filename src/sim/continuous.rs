@@ -34,7 +34,7 @@ use super::collision::narrow_phase::{
 };
 use super::collision::{Contact, Contacts, IndexedContact, find_contacts, search_in_bands};
 use super::messages::{BallCollision, Wall, WallCollision};
-use super::movement::{contain_in_arena, wall_contact_point};
+use super::movement::{contain_in_arena, wall_contact_point, wall_impulse};
 use super::params::{BroadPhase, CollisionMode, MassModel, SimParams};
 use super::response::{normal_exchange, resolve_overlaps, separation_shares, write_back};
 use super::stats::SimStats;
@@ -147,6 +147,16 @@ pub fn wall_time_of_impact(
     first
 }
 
+/// The smallest circle holding `circle` wherever it is while moving at `velocity` for
+/// `seconds`: centred halfway along the path.
+#[inline]
+fn swept_circle(circle: Circle, velocity: DVec2, seconds: f64) -> Circle {
+    Circle::new(
+        circle.center + velocity * (0.5 * seconds),
+        circle.radius + velocity.length() * (0.5 * seconds),
+    )
+}
+
 /// [`time_of_impact`] for pairs closing faster than [`MIN_APPROACH_SPEED`].
 #[inline]
 fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2) -> Option<f64> {
@@ -181,6 +191,34 @@ struct Impact {
 }
 
 impl Impact {
+    /// Ball `ball`, which has had `hits` hits, reaching `wall` at `time`.
+    fn with_wall(time: f64, ball: usize, hits: u32, wall: Wall) -> Self {
+        Self {
+            time,
+            a: ball as u32,
+            other: WALL_BASE + wall as u32,
+            hits_a: hits,
+            hits_other: 0,
+        }
+    }
+
+    /// Balls `i` and `j`, with `hits_i` and `hits_j` hits, meeting at `time`; stored with the
+    /// lower index first, so a pair has one key whichever ball it was found from.
+    fn between(time: f64, (i, hits_i): (usize, u32), (j, hits_j): (usize, u32)) -> Self {
+        let ((a, hits_a), (b, hits_other)) = if i < j {
+            ((i, hits_i), (j, hits_j))
+        } else {
+            ((j, hits_j), (i, hits_i))
+        };
+        Self {
+            time,
+            a: a as u32,
+            other: b as u32,
+            hits_a,
+            hits_other,
+        }
+    }
+
     fn key(&self) -> (u32, u32, u32, u32) {
         (self.a, self.other, self.hits_a, self.hits_other)
     }
@@ -240,12 +278,9 @@ impl Rerouted {
 
     fn reset(&mut self, cell_count: usize) {
         for &cell in &self.used_cells {
-            if let Some(head) = self.head.get_mut(cell as usize) {
-                *head = Self::NONE;
-            }
+            self.head[cell as usize] = Self::NONE;
         }
         self.head.resize(cell_count, Self::NONE);
-        self.head.truncate(cell_count);
         self.used_cells.clear();
         self.entries.clear();
         self.reach = 0.0;
@@ -335,8 +370,6 @@ pub struct Timeline {
     rerouted: Rerouted,
     /// Contacts for the discrete response of a step cut short.
     fallback: Vec<IndexedContact>,
-    /// Hits handled by the last [`run`](Self::run).
-    pub handled: usize,
     /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
     pub cut_short: bool,
 }
@@ -348,13 +381,12 @@ impl Timeline {
     pub fn predict(&mut self, circles: &[Circle], velocities: &[DVec2], spec: StepSpec) {
         let dt = spec.dt;
         self.swept.clear();
-        self.swept
-            .extend(circles.iter().zip(velocities).map(|(circle, velocity)| {
-                Circle::new(
-                    circle.center + *velocity * (0.5 * dt),
-                    circle.radius + velocity.length() * (0.5 * dt),
-                )
-            }));
+        self.swept.extend(
+            circles
+                .iter()
+                .zip(velocities)
+                .map(|(circle, velocity)| swept_circle(*circle, *velocity, dt)),
+        );
         self.grid_reach = self.swept.iter().map(|s| s.radius).fold(0.0, f64::max);
         self.grid.rebuild(&self.swept);
         self.predictions.clear();
@@ -372,13 +404,8 @@ impl Timeline {
                     found.push(Prediction::Overlap(a, b));
                 }
                 if let Some(time) = approach_time(ca, va, cb, vb).filter(|&t| t <= dt) {
-                    found.push(Prediction::Impact(Impact {
-                        time,
-                        a,
-                        other: b,
-                        hits_a: 0,
-                        hits_other: 0,
-                    }));
+                    let impact = Impact::between(time, (a as usize, 0), (b as usize, 0));
+                    found.push(Prediction::Impact(impact));
                 }
             });
         });
@@ -387,13 +414,8 @@ impl Timeline {
                 wall_time_of_impact(circle.center, *velocity, circle.radius, spec.half)
                 && time <= dt
             {
-                self.predictions.push(Prediction::Impact(Impact {
-                    time,
-                    a: index as u32,
-                    other: WALL_BASE + wall as u32,
-                    hits_a: 0,
-                    hits_other: 0,
-                }));
+                let impact = Impact::with_wall(time, index, 0, wall);
+                self.predictions.push(Prediction::Impact(impact));
             }
         }
     }
@@ -431,7 +453,6 @@ impl Timeline {
                 Prediction::Overlap(a, b) => self.overlapping.push((a, b)),
             }
         }
-        self.handled = 0;
         self.cut_short = false;
         while let Some(Reverse(impact)) = self.queue.pop() {
             let a = impact.a as usize;
@@ -466,7 +487,6 @@ impl Timeline {
                         impulse: bounce.impulse,
                         normal_speed: bounce.normal_speed,
                     });
-                    self.handled += 1;
                     self.predict_for(a, now, spec);
                 }
             } else {
@@ -503,7 +523,6 @@ impl Timeline {
                     impulse: exchange.impulse,
                     closing_speed: exchange.closing_speed,
                 });
-                self.handled += 1;
                 self.predict_for(a, now, spec);
                 self.predict_for(b, now, spec);
             }
@@ -564,9 +583,11 @@ impl Timeline {
                     wall: wall_hit.wall,
                     time: spec.dt,
                     point: wall_contact_point(wall_hit.wall, circle.center, spec.half),
-                    impulse: spec.mass_model.mass(circle.radius)
-                        * (1.0 + spec.restitution)
-                        * wall_hit.normal_speed,
+                    impulse: wall_impulse(
+                        spec.mass_model.mass(circle.radius),
+                        spec.restitution,
+                        wall_hit.normal_speed,
+                    ),
                     normal_speed: wall_hit.normal_speed,
                 });
             }
@@ -587,19 +608,16 @@ impl Timeline {
             wall_time_of_impact(circle.center, velocity, circle.radius, spec.half)
             && now + time <= spec.dt
         {
-            queue.push(Reverse(Impact {
-                time: now + time,
-                a: index as u32,
-                other: WALL_BASE + wall as u32,
-                hits_a: mover.hits,
-                hits_other: 0,
-            }));
+            queue.push(Reverse(Impact::with_wall(
+                now + time,
+                index,
+                mover.hits,
+                wall,
+            )));
         }
         let rest = spec.dt - now;
-        let swept = Circle::new(
-            circle.center + velocity * (0.5 * rest),
-            circle.radius + velocity.length() * (0.5 * rest) + SWEPT_MARGIN,
-        );
+        let mut swept = swept_circle(circle, velocity, rest);
+        swept.radius += SWEPT_MARGIN;
         self.rerouted.insert(
             self.grid.cell_index(swept.center),
             index as u32,
@@ -620,18 +638,11 @@ impl Timeline {
             else {
                 return;
             };
-            let (a, b) = if index < other_index {
-                (index, other_index)
-            } else {
-                (other_index, index)
-            };
-            queue.push(Reverse(Impact {
+            queue.push(Reverse(Impact::between(
                 time,
-                a: a as u32,
-                other: b as u32,
-                hits_a: movers[a].hits,
-                hits_other: movers[b].hits,
-            }));
+                (index, mover.hits),
+                (other_index, other_mover.hits),
+            )));
         };
         // Balls on their first path of the step are filed in the grid by the circle that path
         // sweeps; the ones that changed course since, in `rerouted`. Both filters are the
@@ -706,7 +717,11 @@ fn bounce_off_wall(
     Some(WallBounce {
         center,
         point: wall_contact_point(wall, center, spec.half),
-        impulse: spec.mass_model.mass(circle.radius) * (1.0 + spec.restitution) * normal_speed,
+        impulse: wall_impulse(
+            spec.mass_model.mass(circle.radius),
+            spec.restitution,
+            normal_speed,
+        ),
         normal_speed,
     })
 }

@@ -187,6 +187,13 @@ fn move_balls(
     }
 }
 
+/// The impulse a wall gives a ball of `mass` arriving at `normal_speed` with restitution
+/// `restitution`: its normal momentum reversed and scaled, `m (1 + e) v_n`.
+#[inline]
+pub fn wall_impulse(mass: f64, restitution: f64, normal_speed: f64) -> f64 {
+    mass * (1.0 + restitution) * normal_speed
+}
+
 /// The [`WallCollision`]s of a containment: one per wall hit.
 pub fn wall_collisions(
     ball: Entity,
@@ -210,7 +217,7 @@ pub fn wall_collisions(
             wall: hit.wall,
             time,
             point: wall_contact_point(hit.wall, position, half),
-            impulse: mass * (1.0 + restitution) * hit.normal_speed,
+            impulse: wall_impulse(mass, restitution, hit.normal_speed),
             normal_speed: hit.normal_speed,
         })
 }
