@@ -27,6 +27,8 @@ pub mod messages;
 pub mod movement;
 pub mod params;
 pub mod placement;
+#[cfg(test)]
+mod properties;
 pub mod response;
 pub mod scene;
 pub mod spawn;
