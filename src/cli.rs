@@ -13,6 +13,7 @@ use crate::headless::{DEFAULT_DT, StateDump, run_scene_with_threads};
 use crate::play::{CurrentScene, PlayOptions, play};
 use crate::sim::params::MAX_BALLS;
 use crate::sim::{BroadPhase, CollisionMode, SceneFile};
+use crate::soak::soak;
 
 /// The scene played when no `--scene` is given, built in so it works from any directory.
 const DEMO_SCENE: &str = include_str!("../assets/scenes/demo.ron");
@@ -70,6 +71,8 @@ pub enum Command {
     Run(RunArgs),
     /// Time the standard gas at several sizes, on one core and on all, against all pairs.
     Bench(BenchArgs),
+    /// Random scenes across the panel's ranges, each run long with checks after every step.
+    Soak(SoakArgs),
     /// One bench case in this process, printed as JSON (what `bench` runs in its children).
     #[command(hide = true)]
     BenchOne(BenchOneArgs),
@@ -90,6 +93,22 @@ pub struct BenchArgs {
     /// Print the rows as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct SoakArgs {
+    /// Number of random scenes.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub scenes: u64,
+    /// Steps per scene.
+    #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..=MAX_STEPS))]
+    pub steps: u64,
+    /// Seed of the first scene; scene k has seed `seed + k`.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Most balls in a scene.
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=MAX_BENCH_BALLS))]
+    pub max_balls: u64,
 }
 
 #[derive(Debug, clap::Args)]
@@ -184,6 +203,7 @@ impl Cli {
         let outcome = match self.command {
             Some(Command::Run(args)) => run_headless(args),
             Some(Command::Bench(args)) => run_bench(args),
+            Some(Command::Soak(args)) => run_soak(args),
             Some(Command::BenchOne(args)) => run_bench_one(args),
             None => run_window(self.play),
         };
@@ -306,6 +326,15 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     } else {
         print!("{}", format_table(&rows));
     }
+    Ok(())
+}
+
+fn run_soak(args: SoakArgs) -> Result<(), Box<dyn Error>> {
+    let failed = soak(args.seed, args.scenes, args.steps, args.max_balls as usize);
+    if failed > 0 {
+        return Err(format!("{failed} of {} scenes failed", args.scenes).into());
+    }
+    println!("all {} scenes passed", args.scenes);
     Ok(())
 }
 

@@ -7,6 +7,7 @@
 //! - [`ui`]: the egui panel, mouse and keys.
 //! - [`play`]: the windowed toy; [`diagnostics`]: its frame and simulation timings.
 //! - [`bench`]: the standard gas timed at several sizes.
+//! - [`soak`]: random scenes run long with checks after every step.
 //! - [`cli`]: the `ballpit` command line.
 
 pub mod bench;
@@ -16,6 +17,7 @@ pub mod headless;
 pub mod play;
 pub mod render;
 pub mod sim;
+pub mod soak;
 pub mod ui;
 
 /// The types most users of the crate need.

@@ -16,6 +16,7 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy::window::PrimaryWindow;
 
+use crate::sim::params::ARENA_SIDE_RANGE;
 use crate::sim::{Ball, BallId, Position, PreviousPosition, Radius, SimParams, Velocity};
 
 /// Side of the shared circle texture, texels: large enough that a ball 256 px wide is crisp.
@@ -101,9 +102,13 @@ impl Default for PlayArea {
 }
 
 impl PlayArea {
-    /// The arena the window of `window_size` logical pixels shows.
-    pub fn arena_for_window(&self, window_size: Vec2) -> Vec2 {
-        (window_size - Vec2::new(self.panel_width, 0.0)).max(Vec2::ZERO) * self.zoom
+    /// The arena the window of `window_size` logical pixels shows; `None` when it shows none
+    /// (minimised, or no wider than the panel), bounded by the accepted arena sides.
+    pub fn arena_for_window(&self, window_size: Vec2) -> Option<Vec2> {
+        let arena = (window_size - Vec2::new(self.panel_width, 0.0)) * self.zoom;
+        let (smallest, largest) = (*ARENA_SIDE_RANGE.start(), *ARENA_SIDE_RANGE.end());
+        (arena.is_finite() && arena.min_element() as f64 >= smallest)
+            .then(|| arena.min(Vec2::splat(largest as f32)))
     }
 }
 
@@ -242,13 +247,18 @@ fn colour_balls(
 }
 
 /// The arena is the window's play area (right of the panel): its walls follow a resize, and
-/// balls left outside after a shrink are brought back in by the movement stage's walls.
+/// balls left outside after a shrink are brought back in by the walls. A window with no play
+/// area (minimised, or narrower than the panel) leaves the arena as it was, so nothing is
+/// squeezed and the balls are where they were when it comes back.
 fn fit_arena_to_window(
     window: Single<&Window, With<PrimaryWindow>>,
     play_area: Res<PlayArea>,
     mut params: ResMut<SimParams>,
 ) {
-    let size = play_area.arena_for_window(window.size()).as_dvec2();
+    let Some(size) = play_area.arena_for_window(window.size()) else {
+        return;
+    };
+    let size = size.as_dvec2();
     if params.arena_size != size {
         params.arena_size = size;
     }
@@ -299,9 +309,12 @@ mod tests {
         };
         assert_eq!(
             area.arena_for_window(Vec2::new(1000.0, 600.0)),
-            Vec2::new(1600.0, 1200.0)
+            Some(Vec2::new(1600.0, 1200.0))
         );
-        assert_eq!(area.arena_for_window(Vec2::new(100.0, 0.0)), Vec2::ZERO);
+        // Minimised, or no wider than the panel: no arena.
+        assert_eq!(area.arena_for_window(Vec2::ZERO), None);
+        assert_eq!(area.arena_for_window(Vec2::new(200.0, 600.0)), None);
+        assert_eq!(area.arena_for_window(Vec2::new(1000.0, 0.0)), None);
     }
 
     #[test]

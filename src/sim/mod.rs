@@ -104,8 +104,10 @@ impl Plugin for SimPlugin {
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct PendingSteps(pub u32);
 
+/// Steps run unless paused (a pending single step runs anyway) or the arena has no room (a
+/// minimised window): the balls then wait where they are.
 fn simulation_running(params: Res<SimParams>, pending: Res<PendingSteps>) -> bool {
-    !params.paused || pending.0 > 0
+    (!params.paused || pending.0 > 0) && params.has_room()
 }
 
 fn take_pending_step(params: Res<SimParams>, mut pending: ResMut<PendingSteps>) {

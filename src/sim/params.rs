@@ -131,6 +131,13 @@ impl SimParams {
         self.arena_size * 0.5
     }
 
+    /// Whether the arena has room for the simulation to run: both sides at least the smallest
+    /// accepted side. A minimised window leaves it without; the stages then wait.
+    #[inline]
+    pub fn has_room(&self) -> bool {
+        self.arena_size.min_element() >= *ARENA_SIDE_RANGE.start()
+    }
+
     /// Brings every value into its accepted range, replacing non-finite ones with the default,
     /// so that no tuner can hand the simulation a NaN or an out-of-range value.
     pub fn clamp_to_limits(&mut self) {

@@ -53,6 +53,7 @@ const RATE_WINDOW_SECONDS: f64 = 1.0;
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<PanelVisible>()
+        .init_resource::<BallCountNote>()
         .init_resource::<Readouts>()
         .insert_resource(SceneList::read(Path::new(SCENE_FOLDER)))
         .add_systems(Update, update_readouts)
@@ -87,6 +88,24 @@ impl SceneList {
         files.sort();
         SceneList(files)
     }
+}
+
+/// Why the ball count is short of what the slider asked for, shown under the slider until
+/// the next request is met.
+#[derive(Resource, Debug, Clone, Default, PartialEq)]
+pub struct BallCountNote(pub Option<String>);
+
+/// Sets the number of balls as the count slider does; when the arena is full before the
+/// count is reached, says so in the [`BallCountNote`] instead of trying on.
+pub fn request_ball_count(world: &mut World, wanted: usize) {
+    let reached = set_ball_count(world, wanted);
+    let note = (reached < wanted).then(|| {
+        format!(
+            "The arena is full: {reached} of {wanted} balls fit. Shrink the radii or enlarge \
+             the window."
+        )
+    });
+    world.insert_resource(BallCountNote(note));
 }
 
 /// Figures the panel shows, gathered every frame.
@@ -208,6 +227,7 @@ struct Shown<'w> {
     scenes: Res<'w, SceneList>,
     current: Res<'w, CurrentScene>,
     status: Res<'w, SceneStatus>,
+    ball_count_note: Res<'w, BallCountNote>,
 }
 
 fn draw_panel(
@@ -254,7 +274,7 @@ fn draw_panel(
                 });
                 ui.label(RichText::new("Space pause · N step · R reset · H hide").small());
                 controls(ui, &mut tunables, &shown, &mut requests);
-                balls(ui, &mut tunables.spawn, &shown.readouts, &mut commands);
+                balls(ui, &mut tunables.spawn, &shown, &mut commands);
                 physics(ui, &mut tunables);
                 readouts(ui, &shown);
                 gas(ui, &shown.readouts);
@@ -313,16 +333,11 @@ fn controls(
     }
 }
 
-fn balls(
-    ui: &mut egui::Ui,
-    spawn: &mut SpawnSettings,
-    readouts: &Readouts,
-    commands: &mut Commands,
-) {
+fn balls(ui: &mut egui::Ui, spawn: &mut SpawnSettings, shown: &Shown, commands: &mut Commands) {
     egui::CollapsingHeader::new("Balls")
         .default_open(true)
         .show(ui, |ui| {
-            let mut count = readouts.balls;
+            let mut count = shown.readouts.balls;
             let response = ui.add(
                 Slider::new(&mut count, BALL_COUNT_RANGE)
                     .logarithmic(true)
@@ -330,8 +345,11 @@ fn balls(
             );
             if response.changed() {
                 commands.queue(move |world: &mut World| {
-                    set_ball_count(world, count);
+                    request_ball_count(world, count);
                 });
+            }
+            if let Some(note) = &shown.ball_count_note.0 {
+                ui.colored_label(Color32::from_rgb(255, 190, 90), note);
             }
             let mut edited = *spawn;
             ui.add(

@@ -206,11 +206,12 @@ fn runtime_errors_exit_1_naming_the_cause() {
 }
 
 #[test]
-fn the_same_run_with_one_thread_or_three_is_bit_identical() {
+fn the_same_run_with_one_thread_or_three_is_bit_identical_in_both_modes() {
+    // 30,000 balls: above the size at which the pair search runs in parallel bands.
     let dir = std::env::temp_dir().join(format!("ballpit-threads-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let dump = |threads: &str| {
-        let path = dir.join(format!("{threads}.json"));
+    let dump = |mode: &str, threads: &str| {
+        let path = dir.join(format!("{mode}-{threads}.json"));
         ballpit_ok(&[
             "run",
             "--scene",
@@ -220,6 +221,8 @@ fn the_same_run_with_one_thread_or_three_is_bit_identical() {
             "--steps",
             "20",
             "--json",
+            "--collisions",
+            mode,
             "--threads",
             threads,
             "--dump",
@@ -227,10 +230,18 @@ fn the_same_run_with_one_thread_or_three_is_bit_identical() {
         ]);
         std::fs::read(&path).unwrap()
     };
-    let one = dump("1");
-    let three = dump("3");
-    assert!(one.len() > 1_000_000);
-    assert!(one == three, "the dumps differ");
+    for mode in ["continuous", "discrete"] {
+        let one = dump(mode, "1");
+        assert!(one.len() > 1_000_000);
+        assert!(
+            one == dump(mode, "3"),
+            "{mode}: one and three threads differ"
+        );
+        assert!(
+            one == dump(mode, "1"),
+            "{mode}: two runs on one thread differ"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -263,4 +274,25 @@ fn collisions_flag_chooses_the_mode_and_discrete_overlaps_where_continuous_does_
         .sum();
     assert_eq!(counts, 300);
     assert_eq!(histogram["expected"].as_array().unwrap().len(), 40);
+}
+
+#[test]
+fn a_short_soak_passes() {
+    // The short form of `ballpit soak` (the README gives the long one and its figures).
+    let out = ballpit_ok(&[
+        "soak",
+        "--scenes",
+        "8",
+        "--steps",
+        "3000",
+        "--max-balls",
+        "120",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with("ok ")).count(),
+        8,
+        "{stdout}"
+    );
+    assert!(stdout.contains("all 8 scenes passed"), "{stdout}");
 }

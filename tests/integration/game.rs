@@ -117,3 +117,65 @@ fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
         );
     }
 }
+
+#[test]
+fn a_minimised_window_keeps_the_arena_and_every_ball() {
+    let mut app = windowless_game("demo.ron");
+    let window = app
+        .world_mut()
+        .spawn((Window::default(), bevy::window::PrimaryWindow))
+        .id();
+    for _ in 0..3 {
+        app.update();
+    }
+    let arena = app.world().resource::<SimParams>().arena_size;
+    let steps = app.world().resource::<SimStats>().steps;
+    app.world_mut()
+        .get_mut::<Window>(window)
+        .unwrap()
+        .resolution
+        .set(0.0, 0.0);
+    for _ in 0..5 {
+        app.update();
+    }
+    assert_eq!(app.world().resource::<SimParams>().arena_size, arena);
+    assert!(app.world().resource::<SimStats>().steps >= steps + 4);
+    let balls = states(&mut app);
+    assert_eq!(balls.len(), 40);
+    let half = arena / 2.0;
+    for ball in balls {
+        let reach = ball.position.abs() + bevy::math::DVec2::splat(ball.radius);
+        assert!(
+            reach.x <= half.x + 1e-9 && reach.y <= half.y + 1e-9,
+            "{ball:?}"
+        );
+    }
+}
+
+#[test]
+fn asking_for_more_balls_than_fit_gives_a_note_not_a_hang() {
+    let mut app = windowless_game("demo.ron");
+    app.update();
+    let world = app.world_mut();
+    world.resource_mut::<ballpit::sim::SpawnSettings>().radius = (40.0, 40.0);
+    let started = std::time::Instant::now();
+    ballpit::ui::panel::request_ball_count(world, 100_000);
+    let balls = world.query_filtered::<(), With<Ball>>().iter(world).count();
+    let note = world
+        .resource::<ballpit::ui::panel::BallCountNote>()
+        .0
+        .clone();
+    assert!(balls > 40 && balls < 1_000, "{balls}");
+    let note = note.expect("a note when the arena is full");
+    assert!(
+        note.contains(&format!("{balls} of 100000 balls fit")),
+        "{note}"
+    );
+    assert!(started.elapsed().as_secs() < 30);
+    // A request that is met clears it.
+    ballpit::ui::panel::request_ball_count(world, 10);
+    assert_eq!(
+        world.resource::<ballpit::ui::panel::BallCountNote>().0,
+        None
+    );
+}

@@ -393,3 +393,36 @@ fn paused_simulation_does_not_move() {
     assert_eq!(states(&mut app)[0].position, DVec2::ZERO);
     assert_eq!(app.world().resource::<SimStats>().steps, 0);
 }
+
+#[test]
+fn a_zero_sized_arena_makes_the_simulation_wait_and_loses_no_ball() {
+    let balls: Vec<BallState> = (0..40)
+        .map(|i| ball(-300.0 + 15.0 * i as f64, 0.0, 100.0, 37.0 * i as f64, 5.0))
+        .collect();
+    for mode in CollisionMode::ALL {
+        let mut app = app_with(
+            SimParams {
+                collisions: mode,
+                ..params()
+            },
+            &balls,
+        );
+        step(&mut app, 5);
+        let before = states(&mut app);
+        let arena = app.world().resource::<SimParams>().arena_size;
+        // A minimised window: no room, so no step runs and nothing moves.
+        app.world_mut().resource_mut::<SimParams>().arena_size = DVec2::ZERO;
+        step(&mut app, 20);
+        assert_eq!(states(&mut app), before, "{mode:?}");
+        assert_eq!(app.world().resource::<SimStats>().steps, 5);
+        // Restored: it carries on, every ball still there and inside.
+        app.world_mut().resource_mut::<SimParams>().arena_size = arena;
+        step(&mut app, 20);
+        assert_eq!(app.world().resource::<SimStats>().steps, 25);
+        let after = states(&mut app);
+        assert_eq!(after.len(), 40);
+        assert!(after.iter().all(|b| b.position.is_finite()
+            && b.position.x.abs() + b.radius <= arena.x / 2.0 + 1e-9
+            && b.position.y.abs() + b.radius <= arena.y / 2.0 + 1e-9));
+    }
+}
