@@ -64,14 +64,17 @@ pub struct SceneFile {
     #[serde(default)]
     pub arena: Option<ArenaSpec>,
     /// Pixels per second squared, (x, y).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "checked::gravity")]
     pub gravity: (f64, f64),
-    #[serde(default = "perfectly_elastic")]
+    #[serde(
+        default = "perfectly_elastic",
+        deserialize_with = "checked::restitution"
+    )]
     pub restitution: f64,
     #[serde(default)]
     pub mass_model: MassModel,
     /// Per second.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "checked::damping")]
     pub linear_damping: f64,
     /// `Continuous` or `Discrete`; when absent, loading the scene keeps the mode in use.
     #[serde(default)]
@@ -92,7 +95,9 @@ fn perfectly_elastic() -> f64 {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ArenaSpec {
+    #[serde(deserialize_with = "checked::arena_width")]
     pub width: f64,
+    #[serde(deserialize_with = "checked::arena_height")]
     pub height: f64,
 }
 
@@ -100,9 +105,11 @@ pub struct ArenaSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BallSpec {
+    #[serde(deserialize_with = "checked::position")]
     pub position: (f64, f64),
-    #[serde(default)]
+    #[serde(default, deserialize_with = "checked::velocity")]
     pub velocity: (f64, f64),
+    #[serde(deserialize_with = "checked::radius")]
     pub radius: f64,
 }
 
@@ -110,13 +117,16 @@ pub struct BallSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Generate {
+    #[serde(deserialize_with = "checked::count")]
     pub count: usize,
     /// (min, max) pixels.
+    #[serde(deserialize_with = "checked::radius_range")]
     pub radius: (f64, f64),
     /// (min, max) pixels per second.
+    #[serde(deserialize_with = "checked::speed_range")]
     pub speed: (f64, f64),
     /// With no `arena`: the arena is the square in which all balls cover this fraction.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "checked::area_fraction")]
     pub area_fraction: Option<f64>,
     #[serde(default)]
     pub seed: u64,
@@ -228,16 +238,11 @@ impl SceneFile {
     }
 
     fn physics(&self) -> Result<SimParams, String> {
-        let gravity = DVec2::from(self.gravity);
-        if !(gravity.is_finite() && gravity.abs().max_element() <= MAX_GRAVITY) {
-            return Err(format!(
-                "gravity {gravity} must be finite, each component within ±{MAX_GRAVITY}"
-            ));
-        }
-        check_range("restitution", self.restitution, &RESTITUTION_RANGE)?;
-        check_range("linear_damping", self.linear_damping, &DAMPING_RANGE)?;
+        check::gravity(&self.gravity)?;
+        check::restitution(&self.restitution)?;
+        check::damping(&self.linear_damping)?;
         Ok(SimParams {
-            gravity,
+            gravity: DVec2::from(self.gravity),
             restitution: self.restitution,
             mass_model: self.mass_model,
             linear_damping: self.linear_damping,
@@ -256,25 +261,15 @@ impl SceneFile {
             .iter()
             .enumerate()
             .map(|(index, spec)| {
-                let ball = BallState {
+                check::radius(&spec.radius)
+                    .and(check::position(&spec.position))
+                    .and(check::velocity(&spec.velocity))
+                    .map_err(|error| format!("ball {index}: {error}"))?;
+                Ok(BallState {
                     position: DVec2::from(spec.position),
                     velocity: DVec2::from(spec.velocity),
                     radius: spec.radius,
-                };
-                check_range(&format!("ball {index}: radius"), ball.radius, &RADIUS_RANGE)?;
-                if !ball.position.is_finite() {
-                    return Err(format!(
-                        "ball {index}: position {} is not finite",
-                        ball.position
-                    ));
-                }
-                if !(ball.velocity.is_finite() && ball.velocity.length() <= MAX_SPEED) {
-                    return Err(format!(
-                        "ball {index}: velocity {} must be finite with speed at most {MAX_SPEED}",
-                        ball.velocity
-                    ));
-                }
-                Ok(ball)
+                })
             })
             .collect()
     }
@@ -291,9 +286,7 @@ impl SceneFile {
             }
             (None, None) => DEFAULT_ARENA,
         };
-        for (name, side) in [("width", size.x), ("height", size.y)] {
-            check_range(&format!("arena {name}"), side, &ARENA_SIDE_RANGE)?;
-        }
+        check::arena_width(&size.x).and(check::arena_height(&size.y))?;
         Ok(size)
     }
 }
@@ -307,19 +300,11 @@ impl Generate {
                 self.count
             ));
         }
-        let (r_min, r_max) = self.radius;
-        check_range("generate.radius min", r_min, &RADIUS_RANGE)?;
-        check_range("generate.radius max", r_max, &(r_min..=*RADIUS_RANGE.end()))?;
-        let (s_min, s_max) = self.speed;
-        check_range("generate.speed min", s_min, &(0.0..=MAX_SPEED))?;
-        check_range("generate.speed max", s_max, &(s_min..=MAX_SPEED))?;
-        if let Some(fraction) = self.area_fraction {
-            check_range(
-                "generate.area_fraction",
-                fraction,
-                &(f64::MIN_POSITIVE..=DENSEST_PACKING),
-            )?;
-        }
+        check::radius_range(&self.radius)
+            .and(check::speed_range(&self.speed))
+            .and(check::area_fraction(&self.area_fraction))
+            .map_err(|error| format!("generate: {error}"))?;
+        let ((r_min, r_max), (s_min, s_max)) = (self.radius, self.speed);
         Ok((0..self.count)
             .map(|_| {
                 let radius = rng.random_range(r_min..=r_max);
@@ -357,19 +342,152 @@ fn total_disc_area(hand_placed: &[BallState], drawn: &[DrawnBall]) -> f64 {
         .sum()
 }
 
-fn check_range(
-    name: &str,
-    value: f64,
-    range: &std::ops::RangeInclusive<f64>,
-) -> Result<(), String> {
-    if range.contains(&value) {
-        Ok(())
-    } else {
-        Err(format!(
-            "{name} is {value}; it must lie in [{}, {}]",
-            range.start(),
-            range.end()
-        ))
+/// The checks on single values, shared by parsing (which adds the line and column) and by
+/// [`SceneFile::build`] (for scenes made or changed in code, which adds the ball or field).
+mod check {
+    use std::ops::RangeInclusive;
+
+    use super::*;
+
+    fn in_range(value: f64, range: &RangeInclusive<f64>) -> Result<(), String> {
+        if range.contains(&value) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{value} is outside [{}, {}]",
+                range.start(),
+                range.end()
+            ))
+        }
+    }
+
+    fn named(name: &str, result: Result<(), String>) -> Result<(), String> {
+        result.map_err(|error| format!("{name} {error}"))
+    }
+
+    /// A (min, max) pair, each in `range`, min not above max.
+    fn ordered(pair: (f64, f64), range: &RangeInclusive<f64>) -> Result<(), String> {
+        named("min", in_range(pair.0, range))?;
+        named("max", in_range(pair.1, &(pair.0..=*range.end())))
+    }
+
+    pub fn gravity(&(x, y): &(f64, f64)) -> Result<(), String> {
+        named("gravity x", in_range(x, &(-MAX_GRAVITY..=MAX_GRAVITY)))?;
+        named("gravity y", in_range(y, &(-MAX_GRAVITY..=MAX_GRAVITY)))
+    }
+
+    pub fn restitution(value: &f64) -> Result<(), String> {
+        named("restitution", in_range(*value, &RESTITUTION_RANGE))
+    }
+
+    pub fn damping(value: &f64) -> Result<(), String> {
+        named("linear_damping", in_range(*value, &DAMPING_RANGE))
+    }
+
+    pub fn arena_width(value: &f64) -> Result<(), String> {
+        named("arena width", in_range(*value, &ARENA_SIDE_RANGE))
+    }
+
+    pub fn arena_height(value: &f64) -> Result<(), String> {
+        named("arena height", in_range(*value, &ARENA_SIDE_RANGE))
+    }
+
+    pub fn radius(value: &f64) -> Result<(), String> {
+        named("radius", in_range(*value, &RADIUS_RANGE))
+    }
+
+    pub fn position(&(x, y): &(f64, f64)) -> Result<(), String> {
+        if x.is_finite() && y.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("position ({x}, {y}) is not finite"))
+        }
+    }
+
+    pub fn velocity(&(x, y): &(f64, f64)) -> Result<(), String> {
+        let speed = x.hypot(y);
+        named("speed", in_range(speed, &(0.0..=MAX_SPEED)))
+            .map_err(|error| format!("velocity ({x}, {y}): {error}"))
+    }
+
+    pub fn count(value: &usize) -> Result<(), String> {
+        if *value <= MAX_BALLS {
+            Ok(())
+        } else {
+            Err(format!("count {value} is over the limit of {MAX_BALLS}"))
+        }
+    }
+
+    pub fn radius_range(pair: &(f64, f64)) -> Result<(), String> {
+        named("radius", ordered(*pair, &RADIUS_RANGE))
+    }
+
+    pub fn speed_range(pair: &(f64, f64)) -> Result<(), String> {
+        named("speed", ordered(*pair, &(0.0..=MAX_SPEED)))
+    }
+
+    pub fn area_fraction(value: &Option<f64>) -> Result<(), String> {
+        match value {
+            Some(fraction) => named(
+                "area_fraction",
+                in_range(*fraction, &(f64::MIN_POSITIVE..=DENSEST_PACKING)),
+            ),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Deserializers that apply [`check`] as each value is read, so a bad value is reported at
+/// its line and column.
+mod checked {
+    use serde::{Deserialize, Deserializer, de::Error};
+
+    use super::check;
+
+    fn read<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        deserializer: D,
+        check: fn(&T) -> Result<(), String>,
+    ) -> Result<T, D::Error> {
+        let value = T::deserialize(deserializer)?;
+        check(&value).map_err(D::Error::custom)?;
+        Ok(value)
+    }
+
+    pub fn gravity<'de, D: Deserializer<'de>>(d: D) -> Result<(f64, f64), D::Error> {
+        read(d, check::gravity)
+    }
+    pub fn restitution<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        read(d, check::restitution)
+    }
+    pub fn damping<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        read(d, check::damping)
+    }
+    pub fn arena_width<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        read(d, check::arena_width)
+    }
+    pub fn arena_height<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        read(d, check::arena_height)
+    }
+    pub fn position<'de, D: Deserializer<'de>>(d: D) -> Result<(f64, f64), D::Error> {
+        read(d, check::position)
+    }
+    pub fn velocity<'de, D: Deserializer<'de>>(d: D) -> Result<(f64, f64), D::Error> {
+        read(d, check::velocity)
+    }
+    pub fn radius<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        read(d, check::radius)
+    }
+    pub fn count<'de, D: Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+        read(d, check::count)
+    }
+    pub fn radius_range<'de, D: Deserializer<'de>>(d: D) -> Result<(f64, f64), D::Error> {
+        read(d, check::radius_range)
+    }
+    pub fn speed_range<'de, D: Deserializer<'de>>(d: D) -> Result<(f64, f64), D::Error> {
+        read(d, check::speed_range)
+    }
+    pub fn area_fraction<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        read(d, check::area_fraction)
     }
 }
 

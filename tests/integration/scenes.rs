@@ -5,6 +5,7 @@ use std::path::Path;
 
 use ballpit::prelude::*;
 use ballpit::sim::SceneError;
+use ballpit::sim::scene::BallSpec;
 use bevy::math::DVec2;
 
 use crate::common::*;
@@ -117,16 +118,24 @@ fn unknown_fields_are_refused_with_their_position() {
 }
 
 #[test]
-fn bad_radii_name_the_ball() {
+fn bad_radii_name_the_line_in_a_file_and_the_ball_in_code() {
     for radius in ["-1.0", "0.0", "NaN", "inf"] {
         let message = error_of(&format!(
-            "(balls: [(position: (0.0, 0.0), radius: 5.0), (position: (100.0, 0.0), radius: {radius})])"
+            "(balls: [\n  (position: (0.0, 0.0), radius: 5.0),\n  (position: (100.0, 0.0), radius: {radius}),\n])"
         ));
-        assert!(
-            message.starts_with("bad.ron: ball 1: radius"),
-            "{radius}: {message}"
-        );
+        assert!(message.starts_with("bad.ron:3:"), "{radius}: {message}");
+        assert!(message.contains("radius"), "{radius}: {message}");
     }
+    // A scene built in code (or changed after parsing) is checked again when built.
+    let mut scene =
+        SceneFile::parse("(balls: [(position: (0.0, 0.0), radius: 5.0)])", "code").unwrap();
+    scene.balls.push(BallSpec {
+        position: (100.0, 0.0),
+        velocity: (0.0, f64::NAN),
+        radius: 5.0,
+    });
+    let message = scene.build("code").unwrap_err().to_string();
+    assert!(message.starts_with("code: ball 1: velocity"), "{message}");
 }
 
 #[test]
@@ -168,12 +177,12 @@ fn more_balls_than_fit_give_a_message_not_a_hang() {
     assert!(started.elapsed().as_secs() < 30);
     let message =
         error_of("(generate: (count: 2000000, radius: (5, 5), speed: (0, 0), area_fraction: 0.3))");
-    assert!(message.contains("exceeds the limit"), "{message}");
+    assert!(message.contains("over the limit of 1000000"), "{message}");
 }
 
 #[test]
 fn out_of_range_physics_is_refused() {
-    assert!(error_of("(restitution: 1.5)").contains("restitution is 1.5"));
+    assert!(error_of("(restitution: 1.5)").contains("bad.ron:1:15: restitution 1.5 is outside"));
     assert!(error_of("(restitution: -0.1)").contains("restitution"));
     assert!(error_of("(gravity: (0.0, NaN))").contains("gravity"));
     assert!(error_of("(linear_damping: -1.0)").contains("linear_damping"));
