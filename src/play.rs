@@ -24,7 +24,7 @@ const MAX_WINDOW: Vec2 = Vec2::new(1600.0, 1000.0);
 /// Smallest window the toy resizes to for a scene, logical pixels.
 const MIN_WINDOW: Vec2 = Vec2::new(640.0, 400.0);
 /// Fixed steps per second.
-const DEFAULT_STEP_RATE: f64 = 60.0;
+pub const DEFAULT_STEP_RATE: f64 = 60.0;
 
 /// What to play and whether to take a screenshot and quit.
 pub struct PlayOptions {

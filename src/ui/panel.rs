@@ -12,7 +12,7 @@ use bevy::diagnostic::DiagnosticsStore;
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy_egui::egui::{self, Color32, RichText, Slider};
+use bevy_egui::egui::{self, Color32, RichText, Slider, SliderClamping, emath::Numeric};
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
 use egui_plot::{Bar, BarChart, Line, Plot, PlotPoints};
 
@@ -333,13 +333,30 @@ fn controls(
     }
 }
 
+/// A slider that clamps what the player drags or types (NaN and infinities included) to its
+/// range, but leaves alone a value that came from elsewhere: a scene's gravity beyond the
+/// slider's reach stays as the scene set it.
+fn slider<Num: Numeric>(value: &mut Num, range: RangeInclusive<Num>) -> Slider<'_> {
+    Slider::new(value, range).clamping(SliderClamping::Edits)
+}
+
+/// The fixed-step rate to set for a slider value: within the slider's range, the default for
+/// anything that is not a number.
+fn step_rate(slider_value: f64) -> f64 {
+    if slider_value.is_finite() {
+        slider_value.clamp(*STEP_RATE_SLIDER.start(), *STEP_RATE_SLIDER.end())
+    } else {
+        crate::play::DEFAULT_STEP_RATE
+    }
+}
+
 fn balls(ui: &mut egui::Ui, spawn: &mut SpawnSettings, shown: &Shown, commands: &mut Commands) {
     egui::CollapsingHeader::new("Balls")
         .default_open(true)
         .show(ui, |ui| {
             let mut count = shown.readouts.balls;
             let response = ui.add(
-                Slider::new(&mut count, BALL_COUNT_RANGE)
+                slider(&mut count, BALL_COUNT_RANGE)
                     .logarithmic(true)
                     .text("count"),
             );
@@ -353,17 +370,17 @@ fn balls(ui: &mut egui::Ui, spawn: &mut SpawnSettings, shown: &Shown, commands: 
             }
             let mut edited = *spawn;
             ui.add(
-                Slider::new(&mut edited.radius.0, RADIUS_SLIDER)
+                slider(&mut edited.radius.0, RADIUS_SLIDER)
                     .logarithmic(true)
                     .text("radius min"),
             );
             ui.add(
-                Slider::new(&mut edited.radius.1, RADIUS_SLIDER)
+                slider(&mut edited.radius.1, RADIUS_SLIDER)
                     .logarithmic(true)
                     .text("radius max"),
             );
-            ui.add(Slider::new(&mut edited.speed.0, SPEED_SLIDER).text("speed min"));
-            ui.add(Slider::new(&mut edited.speed.1, SPEED_SLIDER).text("speed max"));
+            ui.add(slider(&mut edited.speed.0, SPEED_SLIDER).text("speed min"));
+            ui.add(slider(&mut edited.speed.1, SPEED_SLIDER).text("speed max"));
             edited.clamp_to_limits();
             if edited != *spawn {
                 *spawn = edited;
@@ -390,9 +407,9 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
                 "continuous: every impact at its exact moment, nothing tunnels\n\
                  discrete: the tutorial's move, find overlaps, respond, separate",
             );
-            ui.add(Slider::new(&mut edited.gravity.x, GRAVITY_SLIDER).text("gravity x"));
-            ui.add(Slider::new(&mut edited.gravity.y, GRAVITY_SLIDER).text("gravity y"));
-            ui.add(Slider::new(&mut edited.restitution, 0.0..=1.0).text("restitution"));
+            ui.add(slider(&mut edited.gravity.x, GRAVITY_SLIDER).text("gravity x"));
+            ui.add(slider(&mut edited.gravity.y, GRAVITY_SLIDER).text("gravity y"));
+            ui.add(slider(&mut edited.restitution, 0.0..=1.0).text("restitution"));
             ui.horizontal(|ui| {
                 ui.label("mass");
                 for (model, name) in MassModel::ALL.into_iter().zip(["radius", "area", "unit"]) {
@@ -400,24 +417,22 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
                 }
             });
             ui.add(
-                Slider::new(&mut edited.time_scale, TIME_SCALE_SLIDER)
+                slider(&mut edited.time_scale, TIME_SCALE_SLIDER)
                     .logarithmic(true)
                     .smallest_positive(0.01)
                     .text("time scale"),
             );
-            ui.add(Slider::new(&mut edited.linear_damping, DAMPING_SLIDER).text("damping /s"));
+            ui.add(slider(&mut edited.linear_damping, DAMPING_SLIDER).text("damping /s"));
             edited.clamp_to_limits();
             if edited != *tunables.params {
                 *tunables.params = edited;
             }
             let mut rate = 1.0 / tunables.fixed.timestep().as_secs_f64();
             if ui
-                .add(Slider::new(&mut rate, STEP_RATE_SLIDER).text("steps /s"))
+                .add(slider(&mut rate, STEP_RATE_SLIDER).text("steps /s"))
                 .changed()
             {
-                tunables.fixed.set_timestep_hz(
-                    rate.clamp(*STEP_RATE_SLIDER.start(), *STEP_RATE_SLIDER.end()),
-                );
+                tunables.fixed.set_timestep_hz(step_rate(rate));
             }
         });
 }
@@ -533,4 +548,19 @@ fn gas(ui: &mut egui::Ui, readouts: &Readouts) {
                     );
                 });
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_typed_step_rate_is_bounded_and_not_a_number_gives_the_default() {
+        assert_eq!(step_rate(120.0), 120.0);
+        assert_eq!(step_rate(1e9), *STEP_RATE_SLIDER.end());
+        assert_eq!(step_rate(0.0), *STEP_RATE_SLIDER.start());
+        assert_eq!(step_rate(-5.0), *STEP_RATE_SLIDER.start());
+        assert_eq!(step_rate(f64::NAN), crate::play::DEFAULT_STEP_RATE);
+        assert_eq!(step_rate(f64::INFINITY), crate::play::DEFAULT_STEP_RATE);
+    }
 }
