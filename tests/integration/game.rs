@@ -39,6 +39,38 @@ fn windowless_game(scene: &str) -> App {
     app
 }
 
+/// Adds a primary window (logical size only: nothing opens it).
+fn add_window(app: &mut App) -> Entity {
+    app.world_mut()
+        .spawn((Window::default(), bevy::window::PrimaryWindow))
+        .id()
+}
+
+/// Resizes the window as a player would, then runs `frames` frames.
+fn resize_window(app: &mut App, window: Entity, size: (f32, f32), frames: usize) {
+    let mut entity = app.world_mut().entity_mut(window);
+    entity
+        .get_mut::<Window>()
+        .unwrap()
+        .resolution
+        .set(size.0, size.1);
+    for _ in 0..frames {
+        app.update();
+    }
+}
+
+/// Asserts every ball lies inside the arena.
+fn assert_all_inside(app: &mut App) {
+    let half = app.world().resource::<SimParams>().half_extents();
+    for ball in states(app) {
+        let reach = ball.position.abs() + bevy::math::DVec2::splat(ball.radius);
+        assert!(
+            reach.x <= half.x + 1e-9 && reach.y <= half.y + 1e-9,
+            "{ball:?}"
+        );
+    }
+}
+
 #[test]
 fn the_game_builds_loads_its_scene_and_steps_without_a_window() {
     let mut app = windowless_game("demo.ron");
@@ -77,20 +109,10 @@ fn a_bad_scene_request_keeps_the_current_scene_and_reports() {
 #[test]
 fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
     let mut app = windowless_game("gas.ron");
-    let window = app
-        .world_mut()
-        .spawn((Window::default(), bevy::window::PrimaryWindow))
-        .id();
+    let window = add_window(&mut app);
     // Loading the scene sizes the window to fit it; then the player resizes it.
     app.update();
-    app.world_mut()
-        .get_mut::<Window>(window)
-        .unwrap()
-        .resolution
-        .set(1400.0, 900.0);
-    for _ in 0..3 {
-        app.update();
-    }
+    resize_window(&mut app, window, (1400.0, 900.0), 3);
     // The gas (1,083 px square) is taller than the largest window: shown zoomed out.
     let panel = ballpit::ui::PANEL_WIDTH as f64;
     let zoom = app.world().resource::<ballpit::render::PlayArea>().zoom as f64;
@@ -98,58 +120,27 @@ fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
     let arena = app.world().resource::<SimParams>().arena_size;
     let expected = bevy::math::DVec2::new(1400.0 - panel, 900.0) * zoom;
     assert!((arena - expected).length() < 1e-3, "{arena} vs {expected}");
-    app.world_mut()
-        .get_mut::<Window>(window)
-        .unwrap()
-        .resolution
-        .set(700.0, 500.0);
-    for _ in 0..3 {
-        app.update();
-    }
+    resize_window(&mut app, window, (700.0, 500.0), 3);
     let half = app.world().resource::<SimParams>().half_extents();
     let expected = bevy::math::DVec2::new(700.0 - panel, 500.0) * zoom / 2.0;
     assert!((half - expected).length() < 1e-3, "{half} vs {expected}");
-    for ball in states(&mut app) {
-        let reach = ball.position.abs() + bevy::math::DVec2::splat(ball.radius);
-        assert!(
-            reach.x <= half.x + 1e-9 && reach.y <= half.y + 1e-9,
-            "{ball:?}"
-        );
-    }
+    assert_all_inside(&mut app);
 }
 
 #[test]
 fn a_minimised_window_keeps_the_arena_and_every_ball() {
     let mut app = windowless_game("demo.ron");
-    let window = app
-        .world_mut()
-        .spawn((Window::default(), bevy::window::PrimaryWindow))
-        .id();
+    let window = add_window(&mut app);
     for _ in 0..3 {
         app.update();
     }
     let arena = app.world().resource::<SimParams>().arena_size;
     let steps = app.world().resource::<SimStats>().steps;
-    app.world_mut()
-        .get_mut::<Window>(window)
-        .unwrap()
-        .resolution
-        .set(0.0, 0.0);
-    for _ in 0..5 {
-        app.update();
-    }
+    resize_window(&mut app, window, (0.0, 0.0), 5);
     assert_eq!(app.world().resource::<SimParams>().arena_size, arena);
     assert!(app.world().resource::<SimStats>().steps >= steps + 4);
-    let balls = states(&mut app);
-    assert_eq!(balls.len(), 40);
-    let half = arena / 2.0;
-    for ball in balls {
-        let reach = ball.position.abs() + bevy::math::DVec2::splat(ball.radius);
-        assert!(
-            reach.x <= half.x + 1e-9 && reach.y <= half.y + 1e-9,
-            "{ball:?}"
-        );
-    }
+    assert_eq!(states(&mut app).len(), 40);
+    assert_all_inside(&mut app);
 }
 
 #[test]
