@@ -36,7 +36,7 @@ use super::collision::{Contact, Contacts, IndexedContact, find_contacts, search_
 use super::messages::{BallCollision, Wall, WallCollision};
 use super::movement::{contain_in_arena, wall_contact_point, wall_impulse};
 use super::params::{BroadPhase, CollisionMode, MassModel, SimParams};
-use super::response::{normal_exchange, resolve_overlaps, separation_shares, write_back};
+use super::response::{normal_exchange, resolve_overlaps, separate, write_back};
 use super::stats::SimStats;
 use super::step_seconds;
 
@@ -677,13 +677,11 @@ impl Timeline {
             let Some(geometry) = circle_contact(circles[a], circles[b]) else {
                 continue;
             };
-            let (back, forward) = separation_shares(
-                geometry.depth,
+            let inverse_masses = (
                 spec.mass_model.inverse_mass(circles[a].radius),
                 spec.mass_model.inverse_mass(circles[b].radius),
             );
-            circles[a].center -= geometry.normal * back;
-            circles[b].center += geometry.normal * forward;
+            separate(circles, (a, b), geometry, inverse_masses);
         }
     }
 }

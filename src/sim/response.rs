@@ -118,10 +118,27 @@ pub fn resolve_overlaps(
             velocities[ib] = exchange.velocity_b;
             on_exchange(a, b, geometry, exchange);
         }
-        let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
-        circles[ia].center -= geometry.normal * back;
-        circles[ib].center += geometry.normal * forward;
+        separate(
+            circles,
+            (ia, ib),
+            geometry,
+            (inverse_mass_a, inverse_mass_b),
+        );
     }
+}
+
+/// Moves circles `a` and `b` apart along the contact normal by the contact's depth, shared by
+/// inverse mass ([`separation_shares`]).
+#[inline]
+pub fn separate(
+    circles: &mut [Circle],
+    (a, b): (usize, usize),
+    geometry: ContactGeometry,
+    (inverse_mass_a, inverse_mass_b): (f64, f64),
+) {
+    let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
+    circles[a].center -= geometry.normal * back;
+    circles[b].center += geometry.normal * forward;
 }
 
 fn resolve_contacts(
