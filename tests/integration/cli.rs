@@ -206,6 +206,46 @@ fn runtime_errors_exit_1_naming_the_cause() {
 }
 
 #[test]
+fn bad_values_and_unwritable_files_exit_1_naming_the_file_and_line() {
+    let dir = std::env::temp_dir().join(format!("ballpit-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("bad.ron");
+    std::fs::write(
+        &scene,
+        "(\n  arena: (width: 300.0, height: 200.0),\n  restitution: 3.0,\n)\n",
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let out = ballpit(&["run", "--scene", scene, "--steps", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with(&format!(
+            "error: {scene}:3:16: restitution 3 is outside [0, 1]"
+        )),
+        "{stderr}"
+    );
+    let dump = dir.join("no/such/folder/out.json");
+    let dump = dump.to_str().unwrap();
+    let out = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/head_on.ron",
+        "--steps",
+        "1",
+        "--dump",
+        dump,
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with(&format!("error: {dump}: cannot write")),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn the_same_run_with_one_thread_or_three_is_bit_identical_in_both_modes() {
     // 30,000 balls: above the size at which the pair search runs in parallel bands.
     let dir = std::env::temp_dir().join(format!("ballpit-threads-{}", std::process::id()));
