@@ -5,7 +5,7 @@ use std::path::Path;
 
 use ballpit::prelude::*;
 use ballpit::sim::SceneError;
-use ballpit::sim::scene::BallSpec;
+use ballpit::sim::scene::{BallSpec, audit_scene_text};
 use bevy::math::DVec2;
 
 use crate::common::*;
@@ -236,4 +236,26 @@ fn a_scene_may_choose_its_collision_mode() {
     );
     let error = SceneFile::parse("(\n  collisions: Sideways,\n)", "bad.ron").unwrap_err();
     assert!(error.to_string().starts_with("bad.ron:2:"), "{error}");
+}
+
+#[test]
+fn fuzz_regressions_and_shipped_scenes_pass_the_fuzzer_audit() {
+    // Every input the fuzzer ever failed on is kept in fuzz/regressions/ and replayed here.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut audited = 0;
+    for folder in ["fuzz/regressions", "assets/scenes"] {
+        for entry in std::fs::read_dir(root.join(folder)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.file_name().is_some_and(|name| name == ".gitkeep") {
+                continue;
+            }
+            let bytes = std::fs::read(&path).unwrap();
+            let text = String::from_utf8_lossy(&bytes);
+            if let Err(failure) = audit_scene_text(&text) {
+                panic!("{}: {failure}", path.display());
+            }
+            audited += 1;
+        }
+    }
+    assert!(audited >= 8);
 }
