@@ -14,6 +14,7 @@ use std::time::Instant;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::cli::{BroadPhaseArg, CollisionsArg, flag_value};
 use crate::headless::{DEFAULT_DT, headless_app_with_threads, median};
 use crate::sim::{BroadPhase, CollisionMode, Contacts, SceneFile, SimParams, SimStats};
 
@@ -121,10 +122,6 @@ pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, 
     } else {
         Command::new(exe)
     };
-    let broad_phase = match case.broad_phase {
-        BroadPhase::Grid => "grid",
-        BroadPhase::AllPairs => "all-pairs",
-    };
     let output = command
         .args([
             "bench-one",
@@ -135,14 +132,11 @@ pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, 
         ])
         .args([
             "--broad-phase",
-            broad_phase,
+            &flag_value(BroadPhaseArg::from(case.broad_phase)),
             "--threads",
             &threads.to_string(),
             "--collisions",
-            match case.collisions {
-                CollisionMode::Continuous => "continuous",
-                CollisionMode::Discrete => "discrete",
-            },
+            &flag_value(CollisionsArg::from(case.collisions)),
         ])
         .output()
         .map_err(|e| {

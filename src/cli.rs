@@ -140,12 +140,39 @@ impl From<BroadPhaseArg> for BroadPhase {
     }
 }
 
+impl From<BroadPhase> for BroadPhaseArg {
+    fn from(broad_phase: BroadPhase) -> Self {
+        match broad_phase {
+            BroadPhase::Grid => BroadPhaseArg::Grid,
+            BroadPhase::AllPairs => BroadPhaseArg::AllPairs,
+        }
+    }
+}
+
+/// The text that the command line parses back to `value`.
+pub fn flag_value(value: impl clap::ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .expect("no flag value is hidden")
+        .get_name()
+        .to_string()
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum CollisionsArg {
     /// Every impact at its exact time, in time order (the default).
     Continuous,
     /// The tutorial's method: move, find overlaps, respond, separate.
     Discrete,
+}
+
+impl From<CollisionMode> for CollisionsArg {
+    fn from(mode: CollisionMode) -> Self {
+        match mode {
+            CollisionMode::Continuous => CollisionsArg::Continuous,
+            CollisionMode::Discrete => CollisionsArg::Discrete,
+        }
+    }
 }
 
 impl From<CollisionsArg> for CollisionMode {
@@ -350,4 +377,26 @@ fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
         serde_json::to_string(&run_case(case, args.threads as usize)?)?
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    use super::*;
+
+    #[test]
+    fn flag_values_parse_back_to_the_same_modes() {
+        for mode in CollisionMode::ALL {
+            let text = flag_value(CollisionsArg::from(mode));
+            let parsed = CollisionsArg::from_str(&text, false).unwrap();
+            assert_eq!(CollisionMode::from(parsed), mode, "{text}");
+        }
+        for broad_phase in [BroadPhase::Grid, BroadPhase::AllPairs] {
+            let text = flag_value(BroadPhaseArg::from(broad_phase));
+            let parsed = BroadPhaseArg::from_str(&text, false).unwrap();
+            assert_eq!(BroadPhase::from(parsed), broad_phase, "{text}");
+        }
+        assert_eq!(flag_value(BroadPhaseArg::AllPairs), "all-pairs");
+    }
 }

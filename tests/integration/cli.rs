@@ -336,3 +336,39 @@ fn a_short_soak_passes() {
     );
     assert!(stdout.contains("all 8 scenes passed"), "{stdout}");
 }
+
+#[test]
+fn the_bench_runs_every_case_in_its_children() {
+    let out = ballpit_ok(&[
+        "bench",
+        "--sizes",
+        "200",
+        "--steps",
+        "5",
+        "--all-pairs-max",
+        "200",
+        "--json",
+    ]);
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let row = &rows[0];
+    assert_eq!(row["balls"], 200);
+    for case in [
+        "one_core",
+        "all_cores",
+        "all_pairs",
+        "continuous_one_core",
+        "continuous_all_cores",
+    ] {
+        assert!(
+            row[case]["ms_per_step_median"].as_f64().unwrap() > 0.0,
+            "{case}: {row}"
+        );
+    }
+    // Each child ran the mode and broad phase its case asked for.
+    assert_eq!(row["all_pairs"]["case"]["broad_phase"], "AllPairs");
+    assert_eq!(row["one_core"]["case"]["collisions"], "Discrete");
+    assert_eq!(
+        row["continuous_one_core"]["case"]["collisions"],
+        "Continuous"
+    );
+}
