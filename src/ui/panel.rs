@@ -555,6 +555,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn every_slider_lies_within_what_the_simulation_accepts() {
+        use crate::sim::params::{
+            DAMPING_RANGE, MAX_BALLS, MAX_GRAVITY, MAX_SPEED, RADIUS_RANGE, TIME_SCALE_RANGE,
+        };
+        let within = |inner: &RangeInclusive<f64>, outer: &RangeInclusive<f64>| {
+            outer.contains(inner.start()) && outer.contains(inner.end())
+        };
+        assert!(within(&RADIUS_SLIDER, &RADIUS_RANGE));
+        assert!(within(&SPEED_SLIDER, &(0.0..=MAX_SPEED)));
+        assert!(within(&GRAVITY_SLIDER, &(-MAX_GRAVITY..=MAX_GRAVITY)));
+        assert!(within(&TIME_SCALE_SLIDER, &TIME_SCALE_RANGE));
+        assert!(within(&DAMPING_SLIDER, &DAMPING_RANGE));
+        assert!(*STEP_RATE_SLIDER.start() > 0.0);
+        assert!(*BALL_COUNT_RANGE.end() <= MAX_BALLS);
+    }
+
+    #[test]
     fn a_typed_step_rate_is_bounded_and_not_a_number_gives_the_default() {
         assert_eq!(step_rate(120.0), 120.0);
         assert_eq!(step_rate(1e9), *STEP_RATE_SLIDER.end());
