@@ -1,6 +1,8 @@
 //! The command line: `ballpit` plays (a window), `ballpit run` steps a scene headless and
-//! reports. Exit codes: 0 success, 1 runtime error (bad scene, unwritable file), 2 usage
-//! error (from clap).
+//! reports, `ballpit bench` times the standard gas, `ballpit soak` runs random scenes long
+//! with checks. Exit codes: 0 success, 1 runtime error (bad scene, unwritable file, a failed
+//! soak scene; the message names the file and the line and column or the ball), 2 usage error
+//! (from clap).
 
 use std::error::Error;
 use std::path::PathBuf;
