@@ -267,11 +267,11 @@ pub fn soak_scene(soak: &SoakScene, setup: &SceneSetup, steps: u64) -> SoakOutco
         .check(&balls, &params, false)?;
         let mut restore_at = None;
         while done < steps {
-            let mut params = app.world().resource::<SimParams>().clone();
             if restore_at == Some(done) {
-                params.arena_size = scene_arena;
+                app.world_mut().resource_mut::<SimParams>().arena_size = scene_arena;
                 restore_at = None;
             } else if restore_at.is_none() && rng.random_range(0..STEPS_PER_ACTION) == 0 {
+                let mut params = app.world_mut().resource_mut::<SimParams>();
                 match player_action(&mut rng) {
                     Action::Resize(factor) => {
                         params.arena_size = (scene_arena * factor).clamp(
@@ -287,13 +287,12 @@ pub fn soak_scene(soak: &SoakScene, setup: &SceneSetup, steps: u64) -> SoakOutco
                 }
                 params.clamp_to_limits();
             }
-            app.world_mut().insert_resource(params.clone());
             app.update();
             done += 1;
             read_balls(app.world_mut(), &mut balls);
-            let energy_kept = params.gravity == DVec2::ZERO;
+            let params = app.world().resource::<SimParams>();
             check = check
-                .check(&balls, &params, energy_kept)
+                .check(&balls, params, params.gravity == DVec2::ZERO)
                 .map_err(|error| format!("step {done}: {error}"))?;
         }
         Ok(())

@@ -30,7 +30,7 @@ use super::params::{
     ARENA_SIDE_RANGE, CollisionMode, DAMPING_RANGE, MAX_BALLS, MAX_GRAVITY, MAX_SPEED, MassModel,
     RADIUS_RANGE, RESTITUTION_RANGE, SimParams,
 };
-use super::placement::PlacementGrid;
+use super::placement::{PlacementGrid, overlapping};
 use super::stats::SimStats;
 
 /// Largest scene file read, bytes (a million hand-written balls fit in about 80 MB).
@@ -641,8 +641,10 @@ pub fn audit_scene_text(text: &str) -> Result<(), String> {
     if setup.balls.len() <= AUDIT_MAX_PAIRWISE_BALLS {
         for (i, a) in setup.balls.iter().enumerate() {
             for (j, b) in setup.balls.iter().enumerate().skip(i + 1) {
-                let reach = a.radius + b.radius;
-                if a.position.distance_squared(b.position) < reach * reach * (1.0 - 4e-9) {
+                if overlapping(
+                    Circle::new(a.position, a.radius),
+                    Circle::new(b.position, b.radius),
+                ) {
                     return Err(format!("balls {i} and {j} overlap: {a:?} {b:?}"));
                 }
             }
