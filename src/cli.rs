@@ -1,8 +1,8 @@
-//! The command line: `ballpit` plays (a window), `ballpit run` steps a scene headless and
-//! reports, `ballpit bench` times the standard gas, `ballpit soak` runs random scenes long
-//! with checks. Exit codes: 0 success, 1 runtime error (bad scene, unwritable file, a failed
-//! soak scene; the message names the file and the line and column or the ball), 2 usage error
-//! (from clap).
+//! The command line: `ballpit` plays (a window; with the default `gui` feature only),
+//! `ballpit run` steps a scene headless and reports, `ballpit bench` times the standard gas,
+//! `ballpit soak` runs random scenes long with checks. Exit codes: 0 success, 1 runtime error
+//! (bad scene, unwritable file, a failed soak scene, no window in a headless build; the
+//! message names the file and the line and column or the ball), 2 usage error (from clap).
 
 use std::error::Error;
 use std::path::PathBuf;
@@ -10,15 +10,12 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
-use crate::headless::{DEFAULT_DT, StateDump, run_scene_with_threads};
-use crate::play::{CurrentScene, PlayOptions, play};
+use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
+use crate::commands::run::{StateDump, run_scene_with_threads};
+use crate::commands::soak::soak;
+use crate::headless::DEFAULT_DT;
 use crate::sim::params::MAX_BALLS;
 use crate::sim::{BroadPhase, CollisionMode, SceneFile};
-use crate::soak::soak;
-
-/// The scene played when no `--scene` is given, built in so it works from any directory.
-const DEMO_SCENE: &str = include_str!("../assets/scenes/demo.ron");
 
 /// Largest step count accepted by `run`.
 const MAX_STEPS: u64 = 100_000_000;
@@ -61,7 +58,7 @@ pub struct PlayArgs {
     pub frames: u32,
     /// Collision mode, overriding the scene's.
     #[arg(long, value_enum)]
-    pub collisions: Option<CollisionsArg>,
+    pub collisions: Option<CollisionMode>,
     /// Start paused (Space runs it).
     #[arg(long)]
     pub paused: bool,
@@ -119,71 +116,12 @@ pub struct BenchOneArgs {
     pub balls: u64,
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub steps: u64,
-    #[arg(long, value_enum, default_value_t = BroadPhaseArg::Grid)]
-    pub broad_phase: BroadPhaseArg,
+    #[arg(long, value_enum, default_value_t = BroadPhase::Grid)]
+    pub broad_phase: BroadPhase,
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
     pub threads: u64,
-    #[arg(long, value_enum, default_value_t = CollisionsArg::Discrete)]
-    pub collisions: CollisionsArg,
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum BroadPhaseArg {
-    Grid,
-    AllPairs,
-}
-
-impl From<BroadPhaseArg> for BroadPhase {
-    fn from(arg: BroadPhaseArg) -> Self {
-        match arg {
-            BroadPhaseArg::Grid => BroadPhase::Grid,
-            BroadPhaseArg::AllPairs => BroadPhase::AllPairs,
-        }
-    }
-}
-
-impl From<BroadPhase> for BroadPhaseArg {
-    fn from(broad_phase: BroadPhase) -> Self {
-        match broad_phase {
-            BroadPhase::Grid => BroadPhaseArg::Grid,
-            BroadPhase::AllPairs => BroadPhaseArg::AllPairs,
-        }
-    }
-}
-
-/// The text that the command line parses back to `value`.
-pub fn flag_value(value: impl clap::ValueEnum) -> String {
-    value
-        .to_possible_value()
-        .expect("no flag value is hidden")
-        .get_name()
-        .to_string()
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum CollisionsArg {
-    /// Every impact at its exact time, in time order (the default).
-    Continuous,
-    /// The tutorial's method: move, find overlaps, respond, separate.
-    Discrete,
-}
-
-impl From<CollisionMode> for CollisionsArg {
-    fn from(mode: CollisionMode) -> Self {
-        match mode {
-            CollisionMode::Continuous => CollisionsArg::Continuous,
-            CollisionMode::Discrete => CollisionsArg::Discrete,
-        }
-    }
-}
-
-impl From<CollisionsArg> for CollisionMode {
-    fn from(arg: CollisionsArg) -> Self {
-        match arg {
-            CollisionsArg::Continuous => CollisionMode::Continuous,
-            CollisionsArg::Discrete => CollisionMode::Discrete,
-        }
-    }
+    #[arg(long, value_enum, default_value_t = CollisionMode::Discrete)]
+    pub collisions: CollisionMode,
 }
 
 #[derive(Debug, clap::Args)]
@@ -214,7 +152,7 @@ pub struct RunArgs {
     pub threads: Option<u64>,
     /// Collision mode, overriding the scene's (default: continuous).
     #[arg(long, value_enum)]
-    pub collisions: Option<CollisionsArg>,
+    pub collisions: Option<CollisionMode>,
 }
 
 fn parse_step_seconds(text: &str) -> Result<f64, String> {
@@ -251,12 +189,12 @@ impl Cli {
 fn override_scene(
     scene: &mut SceneFile,
     origin: &str,
-    collisions: Option<CollisionsArg>,
+    collisions: Option<CollisionMode>,
     balls: Option<usize>,
     seed: Option<u64>,
 ) -> Result<(), Box<dyn Error>> {
     if let Some(mode) = collisions {
-        scene.collisions = Some(mode.into());
+        scene.collisions = Some(mode);
     }
     if balls.is_none() && seed.is_none() {
         return Ok(());
@@ -272,7 +210,14 @@ fn override_scene(
     Ok(())
 }
 
+/// The scene played when no `--scene` is given, built in so it works from any directory.
+#[cfg(feature = "gui")]
+const DEMO_SCENE: &str = include_str!("../assets/scenes/demo.ron");
+
+#[cfg(feature = "gui")]
 fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
+    use crate::app::scenes::CurrentScene;
+    use crate::play::{PlayOptions, play};
     let (mut file, origin) = match &args.scene {
         Some(path) => (SceneFile::load(path)?, path.display().to_string()),
         None => (
@@ -293,6 +238,13 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
         bevy::app::AppExit::Success => Ok(()),
         bevy::app::AppExit::Error(code) => Err(format!("the game exited with code {code}").into()),
     }
+}
+
+/// A build without the `gui` feature has no window to play in.
+#[cfg(not(feature = "gui"))]
+fn run_window(_args: PlayArgs) -> Result<(), Box<dyn Error>> {
+    Err("this ballpit was built without the `gui` feature, so it cannot open a window;          `ballpit run`, `bench` and `soak` work headless"
+        .into())
 }
 
 fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
@@ -371,34 +323,12 @@ fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
     let case = BenchCase {
         balls: args.balls as usize,
         steps: args.steps,
-        broad_phase: args.broad_phase.into(),
-        collisions: args.collisions.into(),
+        broad_phase: args.broad_phase,
+        collisions: args.collisions,
     };
     println!(
         "{}",
         serde_json::to_string(&run_case(case, args.threads as usize)?)?
     );
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use clap::ValueEnum;
-
-    use super::*;
-
-    #[test]
-    fn flag_values_parse_back_to_the_same_modes() {
-        for mode in CollisionMode::ALL {
-            let text = flag_value(CollisionsArg::from(mode));
-            let parsed = CollisionsArg::from_str(&text, false).unwrap();
-            assert_eq!(CollisionMode::from(parsed), mode, "{text}");
-        }
-        for broad_phase in [BroadPhase::Grid, BroadPhase::AllPairs] {
-            let text = flag_value(BroadPhaseArg::from(broad_phase));
-            let parsed = BroadPhaseArg::from_str(&text, false).unwrap();
-            assert_eq!(BroadPhase::from(parsed), broad_phase, "{text}");
-        }
-        assert_eq!(flag_value(BroadPhaseArg::AllPairs), "all-pairs");
-    }
 }

@@ -1,31 +1,42 @@
 //! ballpit: circles colliding in a box.
 //!
-//! - [`sim`]: the headless simulation plugin, runnable under `MinimalPlugins`; its stages are
-//!   movement → collision → response, in `FixedUpdate`.
-//! - [`headless`]: step a scene without a window and measure it.
-//! - [`render`]: drawing the simulation in a window (reads its state only).
-//! - [`ui`]: the egui panel, mouse and keys.
-//! - [`play`]: the windowed toy; [`diagnostics`]: its frame and simulation timings.
-//! - [`bench`]: the standard gas timed at several sizes.
-//! - [`soak`]: random scenes run long with checks after every step.
+//! Headless (always built):
+//! - [`sim`]: the simulation plugin, runnable under `MinimalPlugins`; its stages are
+//!   movement → collision → response → report, in its own schedule run from `FixedUpdate`.
+//! - [`headless`]: apps with only the simulation, one fixed step per update; the timing loop.
+//! - [`commands`]: `run` (a scene stepped and reported), `bench` (the standard gas timed at
+//!   several sizes), `soak` (random scenes run long with checks after every step).
 //! - [`cli`]: the `ballpit` command line.
+//!
+//! The toy (the default `gui` feature: window, rendering, egui):
+//! - [`app`]: the toy's shared state (scene requests, view settings);
+//! - [`render`]: drawing the simulation (reads its state only);
+//! - [`ui`]: the egui panel, mouse and keys (send intents);
+//! - [`play`]: the windowed toy put together; [`diagnostics`]: its frame timings.
 
-pub mod bench;
 pub mod cli;
-pub mod diagnostics;
+pub mod commands;
 pub mod headless;
-pub mod play;
-pub mod render;
 pub mod sim;
-pub mod soak;
+
+#[cfg(feature = "gui")]
+pub mod app;
+#[cfg(feature = "gui")]
+pub mod diagnostics;
+#[cfg(feature = "gui")]
+pub mod play;
+#[cfg(feature = "gui")]
+pub mod render;
+#[cfg(feature = "gui")]
 pub mod ui;
 
 /// The types most users of the crate need.
 pub mod prelude {
-    pub use crate::headless::{RunReport, headless_app, run_scene};
+    pub use crate::commands::run::{RunReport, run_scene};
+    pub use crate::headless::headless_app;
     pub use crate::sim::{
-        Ball, BallCollision, BallId, BallState, BroadPhase, CollisionMode, MassModel, Position,
-        Radius, SceneFile, SceneSetup, SimParams, SimPlugin, SimStats, SimSystems, StateSummary,
-        Velocity, Wall, WallCollision,
+        Ball, BallCollision, BallId, BallState, BroadPhase, CollisionMode, Intent, MassModel,
+        Position, Radius, RunControl, SceneFile, SceneSetup, SimClock, SimParams, SimPlugin,
+        SimStats, SimSystems, SimulationStep, Solver, StateSummary, Velocity, Wall, WallCollision,
     };
 }

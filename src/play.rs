@@ -1,30 +1,19 @@
-//! The windowed toy: default plugins, the simulation, its rendering and its UI; the scene being
-//! played and requests to reset, reseed or switch it; optionally a screenshot after a number
-//! of frames (for the README and for checks under Xvfb).
-//!
-//! Scene requests arrive as [`SceneRequest`] messages (from the panel and the keys) and are
-//! applied as world commands in `Update`. A scene that fails to load leaves the current one
-//! playing and its error in [`SceneStatus`].
+//! The windowed toy put together: default plugins, the simulation, the toy's shared state
+//! ([`app`](crate::app)), its rendering, its UI and frame diagnostics; optionally a
+//! screenshot after a number of frames (for the README and for checks under Xvfb).
 
 use std::path::PathBuf;
 
 use bevy::diagnostic::DiagnosticsStore;
-use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
-use bevy::window::{PrimaryWindow, WindowResolution};
-use rand::RngExt;
+use bevy::window::WindowResolution;
 
-use crate::render::{self, PlayArea};
-use crate::sim::{Ball, SceneFile, SimParams, SimPlugin, SimRng};
-use crate::{diagnostics, ui};
-
-/// Largest window the toy opens or resizes to, logical pixels.
-const MAX_WINDOW: Vec2 = Vec2::new(1600.0, 1000.0);
-/// Smallest window the toy resizes to for a scene, logical pixels.
-const MIN_WINDOW: Vec2 = Vec2::new(640.0, 400.0);
-/// Fixed steps per second.
-pub const DEFAULT_STEP_RATE: f64 = 60.0;
+use crate::app::scenes::CurrentScene;
+use crate::app::view::{PANEL_WIDTH, fit_window};
+use crate::sim::params::DEFAULT_STEP_RATE;
+use crate::sim::{Ball, RunControl, SimPlugin};
+use crate::{app, diagnostics, render, ui};
 
 /// What to play and whether to take a screenshot and quit.
 pub struct PlayOptions {
@@ -37,35 +26,9 @@ pub struct PlayOptions {
     pub paused: bool,
 }
 
-/// The scene being played, as a file (so reset and reseed rebuild it), and its name.
-#[derive(Resource, Clone, Debug, PartialEq)]
-pub struct CurrentScene {
-    pub file: SceneFile,
-    pub origin: String,
-}
-
-/// What the player asked to do with the scene.
-#[derive(Message, Clone, Debug, PartialEq)]
-pub enum SceneRequest {
-    /// Rebuild the current scene with the same seed.
-    Reset,
-    /// Rebuild the current scene with a new random seed.
-    NewSeed,
-    /// Switch to the scene file at this path.
-    Load(PathBuf),
-}
-
-/// A scene was (re)loaded: anything that keeps history of the old one starts afresh.
-#[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SceneLoaded;
-
-/// The last scene error, shown in the panel until a scene loads.
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct SceneStatus(pub Option<String>);
-
 /// Opens the window and runs until it is closed (or the screenshot is saved).
 pub fn play(options: PlayOptions) -> AppExit {
-    let window = fit_window(options.arena, ui::PANEL_WIDTH).0;
+    let window = fit_window(options.arena, PANEL_WIDTH).0;
     let mut app = App::new();
     app.add_plugins(DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {
@@ -78,7 +41,7 @@ pub fn play(options: PlayOptions) -> AppExit {
     .add_plugins(GamePlugin)
     .insert_resource(options.scene);
     // Loading a scene keeps the pause state, so this survives the start-up load.
-    app.world_mut().resource_mut::<SimParams>().paused = options.paused;
+    app.world_mut().resource_mut::<RunControl>().paused = options.paused;
     if let Some((path, frames)) = options.screenshot {
         app.insert_resource(ScreenshotPlan {
             path,
@@ -97,81 +60,14 @@ pub struct GamePlugin;
 
 impl Plugin for GamePlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins((SimPlugin, render::plugin, ui::plugin, diagnostics::plugin))
-            .insert_resource(Time::<Fixed>::from_hz(DEFAULT_STEP_RATE))
-            .add_message::<SceneRequest>()
-            .add_message::<SceneLoaded>()
-            .init_resource::<SceneStatus>()
-            .add_systems(Startup, |mut requests: MessageWriter<SceneRequest>| {
-                requests.write(SceneRequest::Reset);
-            })
-            .add_systems(Update, handle_scene_requests);
-    }
-}
-
-/// The window size and zoom that show `arena` beside a panel `panel` pixels wide: the arena at
-/// one pixel per pixel if that fits the largest window, else zoomed out until it does.
-pub fn fit_window(arena: Vec2, panel: f32) -> (Vec2, f32) {
-    let room = MAX_WINDOW - Vec2::new(panel, 0.0);
-    let zoom = (arena / room).max_element().max(1.0);
-    let window = (arena / zoom + Vec2::new(panel, 0.0)).clamp(MIN_WINDOW, MAX_WINDOW);
-    (window, zoom)
-}
-
-fn handle_scene_requests(mut requests: MessageReader<SceneRequest>, mut commands: Commands) {
-    for request in requests.read().cloned() {
-        commands.queue(move |world: &mut World| apply_scene_request(world, request));
-    }
-}
-
-fn apply_scene_request(world: &mut World, request: SceneRequest) {
-    let mut scene = world.resource::<CurrentScene>().clone();
-    match request {
-        SceneRequest::Reset => {}
-        SceneRequest::NewSeed => {
-            let seed = world.resource_mut::<SimRng>().0.random::<u64>();
-            if let Some(generate) = scene.file.generate.as_mut() {
-                generate.seed = seed;
-            }
-        }
-        SceneRequest::Load(path) => match SceneFile::load(&path) {
-            Ok(file) => {
-                scene = CurrentScene {
-                    file,
-                    origin: path.display().to_string(),
-                }
-            }
-            Err(error) => {
-                world.resource_mut::<SceneStatus>().0 = Some(error.to_string());
-                return;
-            }
-        },
-    }
-    match scene.file.build(&scene.origin) {
-        Ok(setup) => {
-            let arena = setup.params.arena_size;
-            setup.apply(world);
-            resize_window_for(world, arena);
-            world.insert_resource(scene);
-            world.resource_mut::<SceneStatus>().0 = None;
-            world.write_message(SceneLoaded);
-        }
-        Err(error) => world.resource_mut::<SceneStatus>().0 = Some(error.to_string()),
-    }
-}
-
-/// Zooms and asks for a window that show `arena` beside the panel. Until the window arrives
-/// the arena keeps the scene's size; then it follows the window.
-fn resize_window_for(world: &mut World, arena: DVec2) {
-    let mut play_area = *world.resource::<PlayArea>();
-    let (wanted, zoom) = fit_window(arena.as_vec2(), play_area.panel_width);
-    play_area.zoom = zoom;
-    world.insert_resource(play_area);
-    let mut windows = world.query_filtered::<&mut Window, With<PrimaryWindow>>();
-    if let Ok(mut window) = windows.single_mut(world)
-        && window.size() != wanted
-    {
-        window.resolution.set(wanted.x, wanted.y);
+        app.add_plugins((
+            SimPlugin,
+            app::plugin,
+            render::plugin,
+            ui::plugin,
+            diagnostics::plugin,
+        ))
+        .insert_resource(Time::<Fixed>::from_hz(DEFAULT_STEP_RATE));
     }
 }
 
@@ -221,19 +117,5 @@ fn take_screenshot_and_exit(
             exit.write(AppExit::error());
         }
         _ => {}
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn small_arenas_show_one_to_one_and_large_ones_zoom_out() {
-        let (window, zoom) = fit_window(Vec2::new(800.0, 600.0), 300.0);
-        assert_eq!((window, zoom), (Vec2::new(1100.0, 600.0), 1.0));
-        let (window, zoom) = fit_window(Vec2::new(3000.0, 3000.0), 300.0);
-        assert_eq!(zoom, 3.0);
-        assert_eq!(window, Vec2::new(1300.0, 1000.0));
     }
 }

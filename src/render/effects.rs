@@ -5,7 +5,7 @@
 
 use bevy::prelude::*;
 
-use super::ViewSettings;
+use crate::app::view::ViewSettings;
 use crate::sim::BallCollision;
 
 /// Live particles at most.

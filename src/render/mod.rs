@@ -1,6 +1,7 @@
 //! Drawing the simulation: a 2D camera, one sprite per ball, overlays and effects. Reads
-//! simulation state; writes only the arena size (the arena is the window's play area). Runs
-//! in the windowed app's `Update`/`PostUpdate`, never in the headless one.
+//! simulation state and the view state ([`app::view`](crate::app::view)); writes only the
+//! arena size (the arena is the window's play area). Runs in the windowed app's
+//! `Update`/`PostUpdate`, never in the headless one.
 //!
 //! Every ball's sprite shares one anti-aliased circle texture made at start-up, so all balls
 //! draw as one batch and stay round at any size. Sprites are placed between the last two
@@ -16,8 +17,10 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy::window::PrimaryWindow;
 
-use crate::sim::params::ARENA_SIDE_RANGE;
-use crate::sim::{Ball, BallId, Position, PreviousPosition, Radius, SimParams, Velocity};
+use crate::app::view::{ColourMode, PlayArea, ViewSettings};
+use crate::sim::{
+    Ball, BallId, Position, PreviousPosition, Radius, RunControl, SimParams, Velocity,
+};
 
 /// Side of the shared circle texture, texels: large enough that a ball 256 px wide is crisp.
 const CIRCLE_TEXTURE_SIZE: u32 = 256;
@@ -32,8 +35,6 @@ const SIZE_COLOUR_RANGE: (f64, f64) = (5.0, 50.0);
 
 pub fn plugin(app: &mut App) {
     app.insert_resource(ClearColor(BACKGROUND))
-        .init_resource::<ViewSettings>()
-        .init_resource::<PlayArea>()
         // The texture must exist before any scene's balls are spawned (in `Startup`).
         .add_systems(PreStartup, make_circle_texture)
         .add_systems(Startup, (spawn_camera, spawn_arena_floor))
@@ -45,71 +46,6 @@ pub fn plugin(app: &mut App) {
                 .before(TransformSystems::Propagate),
         )
         .add_plugins((overlays::plugin, effects::plugin));
-}
-
-/// How balls are coloured.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ColourMode {
-    /// A distinct colour per ball.
-    #[default]
-    ByBall,
-    /// Small balls cool, large balls warm.
-    BySize,
-    /// Slow balls cool, fast balls hot.
-    BySpeed,
-}
-
-/// What the view shows; the panel tunes it.
-#[derive(Resource, Clone, Debug, PartialEq)]
-pub struct ViewSettings {
-    pub colour_mode: ColourMode,
-    pub show_aabbs: bool,
-    pub show_contacts: bool,
-    pub show_velocities: bool,
-    pub show_bursts: bool,
-}
-
-impl Default for ViewSettings {
-    fn default() -> Self {
-        ViewSettings {
-            colour_mode: ColourMode::ByBall,
-            show_aabbs: false,
-            show_contacts: false,
-            show_velocities: false,
-            show_bursts: true,
-        }
-    }
-}
-
-/// How the arena maps onto the window: the side panel covers a strip on the left and the
-/// rest shows the arena, `zoom` arena pixels to a window pixel (more than 1 for arenas larger
-/// than any window).
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
-pub struct PlayArea {
-    /// Logical pixels.
-    pub panel_width: f32,
-    /// Arena pixels per window pixel, at least 1.
-    pub zoom: f32,
-}
-
-impl Default for PlayArea {
-    fn default() -> Self {
-        PlayArea {
-            panel_width: 0.0,
-            zoom: 1.0,
-        }
-    }
-}
-
-impl PlayArea {
-    /// The arena the window of `window_size` logical pixels shows; `None` when it shows none
-    /// (minimised, or no wider than the panel), bounded by the accepted arena sides.
-    pub fn arena_for_window(&self, window_size: Vec2) -> Option<Vec2> {
-        let arena = (window_size - Vec2::new(self.panel_width, 0.0)) * self.zoom;
-        let (smallest, largest) = (*ARENA_SIDE_RANGE.start(), *ARENA_SIDE_RANGE.end());
-        (arena.is_finite() && arena.min_element() as f64 >= smallest)
-            .then(|| arena.min(Vec2::splat(largest as f32)))
-    }
 }
 
 /// The texture every ball sprite draws: a white disc with a one-texel soft edge.
@@ -205,8 +141,8 @@ fn give_ball_a_sprite(
 
 /// How far between the previous and the latest fixed step to draw: 1 (the latest state)
 /// while paused, since no step is under way.
-pub fn interpolation_fraction(fixed: &Time<Fixed>, params: &SimParams) -> f64 {
-    if params.paused {
+pub fn interpolation_fraction(fixed: &Time<Fixed>, run: &RunControl) -> f64 {
+    if run.paused {
         1.0
     } else {
         fixed.overstep_fraction_f64().clamp(0.0, 1.0)
@@ -220,10 +156,10 @@ pub fn drawn_position(previous: &PreviousPosition, position: &Position, fraction
 
 fn place_ball_sprites(
     fixed: Res<Time<Fixed>>,
-    params: Res<SimParams>,
+    run: Res<RunControl>,
     mut balls: Query<(&PreviousPosition, &Position, &mut Transform), With<Ball>>,
 ) {
-    let fraction = interpolation_fraction(&fixed, &params);
+    let fraction = interpolation_fraction(&fixed, &run);
     balls
         .par_iter_mut()
         .for_each(|(previous, position, mut transform)| {
@@ -299,22 +235,6 @@ mod tests {
             drawn_position(&previous, &position, 1.0),
             Vec2::new(10.0, -4.0)
         );
-    }
-
-    #[test]
-    fn the_arena_is_the_window_right_of_the_panel_times_the_zoom() {
-        let area = PlayArea {
-            panel_width: 200.0,
-            zoom: 2.0,
-        };
-        assert_eq!(
-            area.arena_for_window(Vec2::new(1000.0, 600.0)),
-            Some(Vec2::new(1600.0, 1200.0))
-        );
-        // Minimised, or no wider than the panel: no arena.
-        assert_eq!(area.arena_for_window(Vec2::ZERO), None);
-        assert_eq!(area.arena_for_window(Vec2::new(200.0, 600.0)), None);
-        assert_eq!(area.arena_for_window(Vec2::new(1000.0, 0.0)), None);
     }
 
     #[test]

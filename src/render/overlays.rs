@@ -2,13 +2,15 @@
 //! the snooker-style aiming guide. Each is switched in [`ViewSettings`]; the guide shows while
 //! a ball is being dragged. Runs in the windowed app's `Update`.
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::{ViewSettings, drawn_position, interpolation_fraction};
+use super::{drawn_position, interpolation_fraction};
+use crate::app::view::{AimGuide, ViewSettings};
 use crate::sim::aim::{AimTarget, predict_first_hit, time_to_wall};
-use crate::sim::collision::narrow_phase::Circle;
-use crate::sim::{Ball, Contacts, Position, PreviousPosition, Radius, SimParams, Velocity};
+use crate::sim::geometry::Circle;
+use crate::sim::{
+    Ball, ContactPoints, Position, PreviousPosition, Radius, RunControl, SimParams, Velocity,
+};
 
 /// Seconds of motion a velocity arrow shows.
 const ARROW_SECONDS: f32 = 0.2;
@@ -24,41 +26,30 @@ const GUIDE_COLOUR: Color = Color::srgb(0.95, 0.95, 0.95);
 const EXIT_COLOUR: Color = Color::srgb(1.0, 0.55, 0.2);
 
 pub(super) fn plugin(app: &mut App) {
-    app.init_resource::<AimGuide>().add_systems(
+    app.add_systems(
         Update,
         (draw_aabbs, draw_contacts, draw_velocities, draw_aim_guide),
     );
 }
 
-/// The ball being aimed and the velocity it would be flung with; set by the input handling.
-#[derive(Resource, Debug, Default, Clone, Copy, PartialEq)]
-pub struct AimGuide(pub Option<Aim>);
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Aim {
-    pub ball: Entity,
-    /// Pixels per second.
-    pub velocity: DVec2,
-}
-
 fn draw_aabbs(
     view: Res<ViewSettings>,
     fixed: Res<Time<Fixed>>,
-    params: Res<SimParams>,
+    run: Res<RunControl>,
     balls: Query<(&PreviousPosition, &Position, &Radius), With<Ball>>,
     mut gizmos: Gizmos,
 ) {
     if !view.show_aabbs {
         return;
     }
-    let fraction = interpolation_fraction(&fixed, &params);
+    let fraction = interpolation_fraction(&fixed, &run);
     for (previous, position, radius) in &balls {
         let centre = drawn_position(previous, position, fraction);
         gizmos.rect_2d(centre, Vec2::splat(2.0 * radius.0 as f32), AABB_COLOUR);
     }
 }
 
-fn draw_contacts(view: Res<ViewSettings>, contacts: Res<Contacts>, mut gizmos: Gizmos) {
+fn draw_contacts(view: Res<ViewSettings>, contacts: Res<ContactPoints>, mut gizmos: Gizmos) {
     if !view.show_contacts {
         return;
     }
@@ -76,14 +67,14 @@ fn draw_contacts(view: Res<ViewSettings>, contacts: Res<Contacts>, mut gizmos: G
 fn draw_velocities(
     view: Res<ViewSettings>,
     fixed: Res<Time<Fixed>>,
-    params: Res<SimParams>,
+    run: Res<RunControl>,
     balls: Query<(&PreviousPosition, &Position, &Velocity), With<Ball>>,
     mut gizmos: Gizmos,
 ) {
     if !view.show_velocities {
         return;
     }
-    let fraction = interpolation_fraction(&fixed, &params);
+    let fraction = interpolation_fraction(&fixed, &run);
     for (previous, position, velocity) in &balls {
         let start = drawn_position(previous, position, fraction);
         let end = start + velocity.as_vec2() * ARROW_SECONDS;

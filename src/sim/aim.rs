@@ -1,12 +1,13 @@
 //! The aiming guide's prediction: where a ball sent off with some velocity first hits another
 //! ball, and the directions both leave in. Built from the simulation's own collision functions
-//! ([`time_of_impact`], [`collision_point`], [`normal_exchange`]), not a copy, so the guide
-//! shows what the simulation will do. Pure; runs in no schedule.
+//! ([`time_of_impact`], [`collision_point`], [`normal_exchange`], [`wall_time_of_impact`]),
+//! not a copy, so the guide shows what the simulation will do. Pure; runs in no schedule.
 
 use bevy::math::DVec2;
 
-use super::collision::narrow_phase::{Circle, collision_point, time_of_impact};
-use super::response::normal_exchange;
+use super::geometry::circle::{Circle, collision_point, contact_normal, time_of_impact};
+use super::geometry::impulse::normal_exchange;
+use super::geometry::wall::wall_time_of_impact;
 
 /// Another ball the aimed ball might hit, with whatever the caller uses to name it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,7 +59,8 @@ pub fn predict_first_hit<T: Copy>(
         target.circle.center + target.velocity * time,
         target.circle.radius,
     );
-    let normal = (target_at_hit.center - cue_at_hit.center).normalize_or(DVec2::X);
+    let offset = target_at_hit.center - cue_at_hit.center;
+    let normal = contact_normal(offset, offset.length());
     let exchange = normal_exchange(
         velocity,
         target.velocity,
@@ -84,18 +86,10 @@ pub fn predict_first_hit<T: Copy>(
 }
 
 /// Seconds until a ball of `radius` at `center` moving at `velocity` touches a wall of the
-/// arena `[-half, half]`; infinite when it is not moving.
+/// arena `[-half, half]` (the simulation's own [`wall_time_of_impact`]); infinite when it
+/// meets none.
 pub fn time_to_wall(center: DVec2, velocity: DVec2, radius: f64, half: DVec2) -> f64 {
-    (0..2)
-        .map(|axis| {
-            let limit = half[axis] - radius;
-            match velocity[axis] {
-                v if v > 0.0 => ((limit - center[axis]) / v).max(0.0),
-                v if v < 0.0 => ((-limit - center[axis]) / v).max(0.0),
-                _ => f64::INFINITY,
-            }
-        })
-        .fold(f64::INFINITY, f64::min)
+    wall_time_of_impact(center, velocity, radius, half).map_or(f64::INFINITY, |(time, _)| time)
 }
 
 #[cfg(test)]

@@ -1,4 +1,5 @@
-//! The ball components: the simulation's state, one entity per ball.
+//! The ball components, the simulation's state, one entity per ball; and the
+//! [`BallSnapshot`], the same balls in contiguous arrays for the stages to work on.
 //!
 //! Positions and velocities are `f64`: the collision maths (and the continuous mode's time of
 //! impact) keep energy to 1e-6 only with that precision. Rendering converts to `f32`.
@@ -6,7 +7,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::collision::narrow_phase::Circle;
+use super::geometry::Circle;
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
@@ -83,4 +84,46 @@ pub struct BallSnapshot {
     pub circles: Vec<Circle>,
     /// Pixels per second.
     pub velocities: Vec<DVec2>,
+}
+
+impl BallSnapshot {
+    pub fn clear(&mut self) {
+        self.entities.clear();
+        self.circles.clear();
+        self.velocities.clear();
+    }
+
+    pub fn push(&mut self, entity: Entity, circle: Circle, velocity: DVec2) {
+        self.entities.push(entity);
+        self.circles.push(circle);
+        self.velocities.push(velocity);
+    }
+}
+
+/// Writes each ball's new `(position, velocity)` from `new_state(index)`, where `index` is
+/// its place in the snapshot's `entities`; `None` leaves the ball as it is. The query visits
+/// the balls in the snapshot's order (nothing spawns or despawns within a step); should that
+/// ever not hold, the rest are looked up by entity.
+pub fn write_back(
+    entities: &[Entity],
+    balls: &mut Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut new_state: impl FnMut(usize) -> Option<(DVec2, DVec2)>,
+) {
+    let mut matched = 0;
+    for (index, (entity, mut position, mut velocity)) in balls.iter_mut().enumerate() {
+        if entities.get(index) != Some(&entity) {
+            break;
+        }
+        matched = index + 1;
+        if let Some(state) = new_state(index) {
+            (position.0, velocity.0) = state;
+        }
+    }
+    for (index, &entity) in entities.iter().enumerate().skip(matched) {
+        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity)
+            && let Some(state) = new_state(index)
+        {
+            (position.0, velocity.0) = state;
+        }
+    }
 }

@@ -1,9 +1,11 @@
 //! Outward notices from the simulation: one [`BallCollision`] per ball–ball hit and one
-//! [`WallCollision`] per wall hit, written during the fixed step, for effects, counters and
-//! tests. Nothing inside the simulation's own stages depends on them.
+//! [`WallCollision`] per wall hit, written by the report stage at the end of each step, for
+//! effects and tests. Nothing inside the simulation's own stages reads them.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+
+pub use super::geometry::Wall;
 
 /// Two balls that were approaching along their line of centres and exchanged momentum.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -21,27 +23,6 @@ pub struct BallCollision {
     pub impulse: f64,
     /// Speed at which the balls were closing along the normal, pixels per second.
     pub normal_speed: f64,
-}
-
-/// The four sides of the arena.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Wall {
-    Left,
-    Right,
-    Bottom,
-    Top,
-}
-
-impl Wall {
-    /// The wall's outward normal (pointing out of the arena).
-    pub fn outward_normal(self) -> DVec2 {
-        match self {
-            Wall::Left => DVec2::NEG_X,
-            Wall::Right => DVec2::X,
-            Wall::Bottom => DVec2::NEG_Y,
-            Wall::Top => DVec2::Y,
-        }
-    }
 }
 
 /// A ball that reached a wall while moving into it and bounced.

@@ -2,121 +2,177 @@
 //! no window, asset, render or egui resource, so it runs under `MinimalPlugins` in tests, on
 //! the command line and in benchmarks exactly as it does in the game.
 //!
-//! One fixed step, in `FixedUpdate`, is four ordered sets (chained once, below).
-//! [`SimParams::collisions`] chooses the systems of stages 2 and 3:
+//! **The pipeline.** One fixed step is one run of the simulation's own schedule,
+//! [`SimSchedule`], which the host's `FixedUpdate` runs in the [`SimulationStep`] set after
+//! applying the [`Intent`]s sent since the last step. Its stages, chained once in
+//! [`SimPlugin`], and the system that fills each in each [`CollisionMode`] (the table in
+//! `SimPlugin::build`):
 //!
-//! 1. [`SimSystems::Movement`]: integrate velocity (and, in discrete mode, position and the
-//!    walls); copy every ball into the contiguous [`BallSnapshot`](ball::BallSnapshot).
-//! 2. [`SimSystems::Collision`]: discrete, broad phase (grid), AABB test, exact distance test →
-//!    [`Contacts`] (`collision`); continuous, the exact time of impact of every approaching
-//!    pair and wall within the step (`continuous`).
-//! 3. [`SimSystems::Response`]: discrete, exchange along each contact normal, separation, walls
-//!    (`response`); continuous, the impacts in time order, predicting anew after each
-//!    (`continuous`). Either writes the balls back.
-//! 4. [`SimSystems::Bookkeeping`]: counters from the collision messages; debug invariants.
+//! | stage | discrete | continuous |
+//! |---|---|---|
+//! | [`SimSystems::Movement`] | [`move_and_contain`](movement::move_and_contain): velocity, position, walls | [`integrate_velocities`](movement::integrate_velocities): velocity only |
+//! | [`SimSystems::Collision`] | [`detect_contacts`](discrete::detect::detect_contacts): grid, AABB, distance → [`Contacts`](discrete::detect::Contacts) | [`predict_impacts`](continuous::predict_impacts): every time of impact within the step |
+//! | [`SimSystems::Response`] | [`resolve_contacts`](discrete::resolve::resolve_contacts): exchange, separation, walls | [`run_timeline`](continuous::run_timeline): the impacts in time order |
+//! | [`SimSystems::Report`] | [`report_step`](report::report_step): messages, counters, contact points | the same |
 //!
-//! Data flows one way: components → snapshot → contacts or impacts → components, and outward
-//! as [`BallCollision`] / [`WallCollision`] messages.
+//! **Data flows one way**: components → [`BallSnapshot`](ball::BallSnapshot) (movement) →
+//! contacts or predicted impacts (collision) → components (response), each stage recording
+//! what happened in the [`StepLog`](report::StepLog); the report stage turns that into the
+//! outward [`BallCollision`] / [`WallCollision`] messages and the [`SimStats`] counters. Every
+//! stage reads the step's `dt` from the [`SimClock`].
+//!
+//! **Where things live**: [`geometry`] the pure maths (circles, walls, impulses, the grid);
+//! [`discrete`] and [`continuous`] one folder per mode; [`measure`] what reads the state
+//! without changing it; [`scene`] scene files; [`params`] the parameters by owner.
 
 pub mod aim;
 pub mod ball;
-pub mod collision;
+pub mod clock;
 pub mod continuous;
-pub mod gas;
+pub mod discrete;
+pub mod geometry;
+pub mod intents;
+pub mod measure;
 pub mod messages;
 pub mod movement;
 pub mod params;
-pub mod placement;
 #[cfg(test)]
 mod properties;
-pub mod response;
+pub mod report;
 pub mod scene;
 pub mod spawn;
-pub mod stats;
 
-use bevy::ecs::schedule::SingleThreadedExecutor;
+use bevy::ecs::schedule::{
+    IntoScheduleConfigs, ScheduleConfigs, ScheduleLabel, SingleThreadedExecutor,
+};
+use bevy::ecs::system::ScheduleSystem;
 use bevy::prelude::*;
 
 pub use ball::{Ball, BallId, BallState, Position, PreviousPosition, Radius, Velocity};
-pub use collision::{Contact, Contacts};
+pub use clock::SimClock;
+pub use intents::{BallCountOutcome, Intent};
+pub use measure::{SimStats, StateSummary};
 pub use messages::{BallCollision, Wall, WallCollision};
-pub use params::{BroadPhase, CollisionMode, MassModel, SimParams};
+pub use params::{BroadPhase, CollisionMode, MassModel, RunControl, SimParams, Solver};
+pub use report::ContactPoints;
 pub use scene::{SceneError, SceneFile, SceneSetup, SimRng};
 pub use spawn::SpawnSettings;
-pub use stats::{SimStats, StateSummary};
 
-/// The simulation's stages, run in this order every fixed step.
+/// The simulation's own schedule: one fixed step. The host runs it from `FixedUpdate`; its
+/// executor is the simulation's business (one thread: the stages are chained, and each uses
+/// the compute pool inside itself where that pays).
+#[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SimSchedule;
+
+/// The stages of [`SimSchedule`], run in this order every step.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SimSystems {
-    /// Integrate motion and keep balls inside the arena.
+    /// Integrate motion (and, in discrete mode, keep balls inside the arena); fill the
+    /// snapshot.
     Movement,
     /// Find touching pairs (discrete) or predict the step's impacts (continuous).
     Collision,
     /// Exchange momentum along contact normals and separate overlapping pairs (discrete), or
     /// handle the impacts in time order (continuous).
     Response,
-    /// Count steps and collisions; check invariants in debug builds.
-    Bookkeeping,
+    /// Turn what the step recorded into messages and counters; advance the clock; check
+    /// invariants in debug builds.
+    Report,
 }
 
-/// Adds the simulation: its resources, messages and the four ordered stages.
+/// The simulation's place in the host's `FixedUpdate`: the player's intents applied, then
+/// one step of [`SimSchedule`] unless paused. Order anything that reads the step's messages
+/// after it.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SimulationStep;
+
+/// Adds the simulation: its resources, messages and schedule, run from `FixedUpdate`.
 pub struct SimPlugin;
 
 impl Plugin for SimPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<SimParams>()
-            .init_resource::<PendingSteps>()
-            .add_message::<BallCollision>()
-            .add_message::<WallCollision>()
-            .configure_sets(
-                FixedUpdate,
-                (
-                    SimSystems::Movement,
-                    SimSystems::Collision,
-                    SimSystems::Response,
-                    SimSystems::Bookkeeping,
-                )
-                    .chain()
-                    .run_if(simulation_running),
-            )
-            .add_plugins((
-                movement::plugin,
-                collision::plugin,
-                continuous::plugin,
-                response::plugin,
-                stats::plugin,
-                scene::plugin,
-                spawn::plugin,
-            ))
+        use CollisionMode::{Continuous, Discrete};
+        use SimSystems::{Collision, Movement, Report, Response};
+        add_resources_and_messages(app);
+        let mut schedule = Schedule::new(SimSchedule);
+        schedule.set_executor(SingleThreadedExecutor::default());
+        app.add_schedule(schedule)
+            .configure_sets(SimSchedule, (Movement, Collision, Response, Report).chain())
             .add_systems(
-                FixedUpdate,
-                take_pending_step.in_set(SimSystems::Bookkeeping),
-            )
-            // The stages are chained, so no two of them could run at once; each uses the
-            // compute pool inside itself where that pays. One thread saves the wake-ups.
-            .edit_schedule(FixedUpdate, |schedule| {
-                schedule.set_executor(SingleThreadedExecutor::default());
-            });
+                SimSchedule,
+                (
+                    clock::start_step.before(Movement),
+                    // The pipeline: each stage, the system of each mode.
+                    stage(Movement, Discrete, movement::move_and_contain),
+                    stage(Movement, Continuous, movement::integrate_velocities),
+                    stage(Collision, Discrete, discrete::detect::detect_contacts),
+                    stage(Collision, Continuous, continuous::predict_impacts),
+                    stage(Response, Discrete, discrete::resolve::resolve_contacts),
+                    stage(Response, Continuous, continuous::run_timeline),
+                    (report::report_step, take_pending_step, clock::end_step)
+                        .chain()
+                        .in_set(Report),
+                ),
+            );
+        #[cfg(debug_assertions)]
+        app.add_systems(SimSchedule, report::assert_state_is_finite.in_set(Report));
+        app.add_systems(
+            FixedUpdate,
+            (intents::apply_intents, run_step.run_if(simulation_running))
+                .chain()
+                .in_set(SimulationStep),
+        );
     }
 }
 
-/// Steps to run although the simulation is paused: the panel's and the N key's single step.
-#[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
-pub struct PendingSteps(pub u32);
+fn add_resources_and_messages(app: &mut App) {
+    app.init_resource::<SimParams>()
+        .init_resource::<Solver>()
+        .init_resource::<RunControl>()
+        .init_resource::<SimClock>()
+        .init_resource::<SimStats>()
+        .init_resource::<SimRng>()
+        .init_resource::<ball::NextBallId>()
+        .init_resource::<ball::BallSnapshot>()
+        .init_resource::<report::StepLog>()
+        .init_resource::<ContactPoints>()
+        .init_resource::<discrete::detect::Contacts>()
+        .init_resource::<discrete::detect::DetectionGrid>()
+        .init_resource::<continuous::Timeline>()
+        .init_resource::<SpawnSettings>()
+        .init_resource::<BallCountOutcome>()
+        .add_message::<Intent>()
+        .add_message::<BallCollision>()
+        .add_message::<WallCollision>();
+}
+
+/// `system` in stage `set`, run only in collision mode `mode`.
+fn stage<M>(
+    set: SimSystems,
+    mode: CollisionMode,
+    system: impl IntoScheduleConfigs<ScheduleSystem, M>,
+) -> ScheduleConfigs<ScheduleSystem> {
+    system.in_set(set).run_if(in_mode(mode))
+}
+
+/// A run condition: the simulation is in collision mode `mode`.
+pub fn in_mode(mode: CollisionMode) -> impl FnMut(Res<Solver>) -> bool + Clone {
+    move |solver: Res<Solver>| solver.collisions == mode
+}
 
 /// Steps run unless paused (a pending single step runs anyway) or the arena has no room (a
 /// minimised window): the balls then wait where they are.
-fn simulation_running(params: Res<SimParams>, pending: Res<PendingSteps>) -> bool {
-    (!params.paused || pending.0 > 0) && params.has_room()
+fn simulation_running(params: Res<SimParams>, run: Res<RunControl>) -> bool {
+    run.wants_step() && params.has_room()
 }
 
-fn take_pending_step(params: Res<SimParams>, mut pending: ResMut<PendingSteps>) {
-    if params.paused {
-        pending.0 = pending.0.saturating_sub(1);
+/// One fixed step: one run of [`SimSchedule`].
+fn run_step(world: &mut World) {
+    world.run_schedule(SimSchedule);
+}
+
+fn take_pending_step(mut run: ResMut<RunControl>) {
+    if run.paused {
+        run.pending_steps = run.pending_steps.saturating_sub(1);
     }
-}
-
-/// Simulated seconds in this fixed step: the fixed timestep scaled by `time_scale`.
-pub fn step_seconds(time: &Time, params: &SimParams) -> f64 {
-    time.delta_secs_f64() * params.time_scale
 }

@@ -8,13 +8,14 @@
 use bevy::math::DVec2;
 use proptest::prelude::*;
 
-use super::collision::narrow_phase::{
+use super::continuous::{StepSpec, Timeline};
+use super::discrete::resolve::resolve_overlaps;
+use super::geometry::circle::{
     Circle, circle_contact, circles_touch, collision_point, time_of_impact,
 };
-use super::continuous::{StepSpec, Timeline, wall_time_of_impact};
-use super::movement::contain_in_arena;
+use super::geometry::impulse::normal_exchange;
+use super::geometry::wall::{contain_in_arena, wall_time_of_impact};
 use super::params::{MAX_SPEED, MassModel, RADIUS_RANGE};
-use super::response::{normal_exchange, resolve_overlaps};
 
 /// Relative tolerance for one hit.
 const ONE_HIT: f64 = 1e-12;

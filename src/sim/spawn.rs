@@ -1,25 +1,21 @@
 //! Adding and removing balls in a running simulation: the ball-count slider grows or shrinks
-//! the population, a click puts a ball in free space. World functions that the UI queues as
-//! commands, and the pure geometry behind them; no systems of their own.
+//! the population, a click puts a ball in free space. World functions that the
+//! [`Intent`](super::Intent)s call in the fixed step, and the pure geometry behind them; no
+//! systems of their own.
 
 use std::ops::RangeInclusive;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use rand::RngExt;
 
 use super::ball::{Ball, BallId, BallState, NextBallId, Position, Radius, ball_bundle};
-use super::collision::narrow_phase::Circle;
+use super::geometry::Circle;
 use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, SimParams};
-use super::placement::PlacementGrid;
-use super::scene::SimRng;
+use super::scene::placement::PlacementGrid;
+use super::scene::{SimRng, draw_ball};
 
 /// Random placement tries per added ball before the arena counts as full.
 const PLACEMENT_TRIES: u32 = 200;
-
-pub(super) fn plugin(app: &mut App) {
-    app.init_resource::<SpawnSettings>();
-}
 
 /// Radius and speed ranges for balls added while running (the count slider, clicks).
 #[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq)]
@@ -97,12 +93,10 @@ pub fn set_ball_count(world: &mut World, target: usize) -> usize {
     let mut count = balls.len();
     let mut rng = world.resource_mut::<SimRng>().0.clone();
     while count < target {
-        let radius = rng.random_range(settings.radius.0..=settings.radius.1);
+        let (radius, velocity) = draw_ball(&mut rng, settings.radius, settings.speed);
         let Some(position) = grid.random_free_spot(radius, half, &mut rng, PLACEMENT_TRIES) else {
             break;
         };
-        let speed = rng.random_range(settings.speed.0..=settings.speed.1);
-        let velocity = DVec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)) * speed;
         grid.insert(Circle::new(position, radius));
         spawn_ball(
             world,

@@ -2,7 +2,8 @@
 //! allow and the room permits). Drag from a ball and release: it is flung with a velocity from
 //! the drag, and while dragging the aiming guide shows what it will hit. Space pauses, N steps
 //! once, R resets, H hides the panel. Pointer and keys over the panel stay with the panel.
-//! Runs in the windowed app's `Update`.
+//! Balls are added and flung through [`Intent`]s, applied in the fixed step. Runs in the
+//! windowed app's `Update`.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -10,14 +11,11 @@ use bevy::window::PrimaryWindow;
 use bevy_egui::input::{egui_wants_any_keyboard_input, egui_wants_any_pointer_input};
 use rand::RngExt;
 
-use super::panel::PanelVisible;
-use crate::play::SceneRequest;
-use crate::render::overlays::{Aim, AimGuide};
-use crate::sim::collision::narrow_phase::Circle;
-use crate::sim::spawn::{fit_radius_at, spawn_ball};
-use crate::sim::{
-    Ball, BallState, PendingSteps, Position, Radius, SimParams, SimRng, SpawnSettings, Velocity,
-};
+use crate::app::scenes::SceneRequest;
+use crate::app::view::{Aim, AimGuide, PanelVisible, UiRng};
+use crate::sim::geometry::Circle;
+use crate::sim::spawn::fit_radius_at;
+use crate::sim::{Ball, BallState, Intent, Position, Radius, RunControl, SimParams, SpawnSettings};
 
 /// Fling speed per pixel of drag, per second: a 100 px drag flings at 300 px/s.
 pub const FLING_GAIN: f64 = 3.0;
@@ -77,9 +75,9 @@ fn press_pointer(
     balls: Query<(Entity, &Position, &Radius), With<Ball>>,
     params: Res<SimParams>,
     settings: Res<SpawnSettings>,
-    mut rng: ResMut<SimRng>,
+    mut rng: ResMut<UiRng>,
     mut guide: ResMut<AimGuide>,
-    mut commands: Commands,
+    mut intents: MessageWriter<Intent>,
 ) {
     if !buttons.just_pressed(MouseButton::Left) {
         return;
@@ -102,14 +100,11 @@ fn press_pointer(
         params.half_extents(),
         circles.map(|(_, c)| c),
     ) {
-        let state = BallState {
+        intents.write(Intent::Spawn(BallState {
             position: point,
             velocity: DVec2::ZERO,
             radius,
-        };
-        commands.queue(move |world: &mut World| {
-            spawn_ball(world, state);
-        });
+        }));
     }
 }
 
@@ -117,11 +112,12 @@ fn drag_and_release(
     buttons: Res<ButtonInput<MouseButton>>,
     window: Single<&Window, With<PrimaryWindow>>,
     camera: Single<(&Camera, &GlobalTransform)>,
-    mut balls: Query<(&Position, &mut Velocity), With<Ball>>,
+    balls: Query<&Position, With<Ball>>,
     mut guide: ResMut<AimGuide>,
+    mut intents: MessageWriter<Intent>,
 ) {
     let Some(aim) = guide.0 else { return };
-    let Ok((position, mut velocity)) = balls.get_mut(aim.ball) else {
+    let Ok(position) = balls.get(aim.ball) else {
         guide.0 = None; // the ball is gone (reset, count lowered)
         return;
     };
@@ -133,24 +129,25 @@ fn drag_and_release(
             ..aim
         });
     } else {
-        velocity.0 = fling;
+        intents.write(Intent::Fling {
+            ball: aim.ball,
+            velocity: fling,
+        });
         guide.0 = None;
     }
 }
 
 fn handle_keys(
     keys: Res<ButtonInput<KeyCode>>,
-    mut params: ResMut<SimParams>,
-    mut pending: ResMut<PendingSteps>,
+    mut run: ResMut<RunControl>,
     mut panel: ResMut<PanelVisible>,
     mut requests: MessageWriter<SceneRequest>,
 ) {
     if keys.just_pressed(KeyCode::Space) {
-        params.paused = !params.paused;
+        run.paused = !run.paused;
     }
     if keys.just_pressed(KeyCode::KeyN) {
-        params.paused = true;
-        pending.0 += 1;
+        run.step_once();
     }
     if keys.just_pressed(KeyCode::KeyR) {
         requests.write(SceneRequest::Reset);

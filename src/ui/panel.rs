@@ -1,73 +1,38 @@
 //! The egui side panel: every tunable live (sliders, buttons, scene picker, overlays) and
 //! readouts (FPS, balls, collisions per second, energy, momentum, an energy plot; the gas's
-//! temperature, pressure and speed histogram against the Maxwell–Boltzmann curve). Edits go to
-//! copies that are clamped to their limits and written back only when they changed. Runs in
-//! `EguiPrimaryContextPass`; [`Readouts`] are gathered in `Update`.
+//! temperature, pressure and speed histogram against the Maxwell–Boltzmann curve). Edits go
+//! to copies that are clamped to their limits and written back only when they changed; the
+//! ball count is an [`Intent`]. Runs in `EguiPrimaryContextPass`; the [`Readouts`] it shows
+//! are gathered in `Update`.
 
-use std::collections::VecDeque;
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::ecs::system::SystemParam;
-use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, RichText, Slider, SliderClamping, emath::Numeric};
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
 use egui_plot::{Bar, BarChart, Line, Plot, PlotPoints};
 
-use super::PANEL_WIDTH;
+use super::readouts::Readouts;
+use crate::app::scenes::{CurrentScene, SceneRequest, SceneStatus};
+use crate::app::view::{ColourMode, PANEL_WIDTH, PanelVisible, PlayArea, ViewSettings};
 use crate::diagnostics::frame_figures;
-use crate::play::{CurrentScene, SceneLoaded, SceneRequest, SceneStatus};
-use crate::render::{ColourMode, PlayArea, ViewSettings};
-use crate::sim::gas::{SPEED_BINS, SpeedHistogram};
-use crate::sim::spawn::set_ball_count;
-use crate::sim::stats::kinetic_energy;
+use crate::sim::params::{
+    BALL_COUNT_SLIDER, DAMPING_SLIDER, DEFAULT_STEP_RATE, GRAVITY_SLIDER, RADIUS_SLIDER,
+    SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
+};
 use crate::sim::{
-    Ball, CollisionMode, MassModel, PendingSteps, Radius, SimParams, SimStats, SpawnSettings,
-    Velocity,
+    BallCountOutcome, CollisionMode, Intent, MassModel, RunControl, SimParams, Solver,
+    SpawnSettings,
 };
 
 /// Where the scene picker looks for scene files, relative to the working directory.
 pub const SCENE_FOLDER: &str = "assets/scenes";
-/// The ball-count slider's range.
-pub const BALL_COUNT_RANGE: RangeInclusive<usize> = 0..=100_000;
-/// The radius sliders' range, pixels.
-pub const RADIUS_SLIDER: RangeInclusive<f64> = 0.5..=200.0;
-/// The speed sliders' range, pixels per second.
-pub const SPEED_SLIDER: RangeInclusive<f64> = 0.0..=3_000.0;
-/// The gravity sliders' range (each component), pixels per second squared.
-pub const GRAVITY_SLIDER: RangeInclusive<f64> = -3_000.0..=3_000.0;
-/// The time-scale slider's range.
-pub const TIME_SCALE_SLIDER: RangeInclusive<f64> = 0.0..=10.0;
-/// The fixed-step rate slider's range, steps per second.
-pub const STEP_RATE_SLIDER: RangeInclusive<f64> = 10.0..=480.0;
-/// The damping slider's range, per second.
-pub const DAMPING_SLIDER: RangeInclusive<f64> = 0.0..=10.0;
-/// Simulated seconds of kinetic energy the plot shows.
-const PLOT_SECONDS: f64 = 10.0;
-/// Simulated seconds between plot samples.
-const PLOT_SAMPLE_SECONDS: f64 = 0.05;
-/// Simulated seconds over which collisions per second are counted.
-const RATE_WINDOW_SECONDS: f64 = 1.0;
-
 pub(super) fn plugin(app: &mut App) {
-    app.init_resource::<PanelVisible>()
-        .init_resource::<BallCountNote>()
-        .init_resource::<Readouts>()
-        .insert_resource(SceneList::read(Path::new(SCENE_FOLDER)))
-        .add_systems(Update, update_readouts)
+    app.insert_resource(SceneList::read(Path::new(SCENE_FOLDER)))
         .add_systems(EguiPrimaryContextPass, draw_panel);
-}
-
-/// Whether the panel is shown (H toggles it).
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PanelVisible(pub bool);
-
-impl Default for PanelVisible {
-    fn default() -> Self {
-        PanelVisible(true)
-    }
 }
 
 /// The scene files the picker offers.
@@ -90,133 +55,26 @@ impl SceneList {
     }
 }
 
-/// Why the ball count is short of what the slider asked for, shown under the slider until
-/// the next request is met.
-#[derive(Resource, Debug, Clone, Default, PartialEq)]
-pub struct BallCountNote(pub Option<String>);
-
-/// Sets the number of balls as the count slider does; when the arena is full before the
-/// count is reached, says so in the [`BallCountNote`] instead of trying on.
-pub fn request_ball_count(world: &mut World, wanted: usize) {
-    let reached = set_ball_count(world, wanted);
-    let note = (reached < wanted).then(|| {
+/// What the panel says under the count slider when the last count asked for was not
+/// reached: the arena is full.
+pub fn ball_count_note(outcome: &BallCountOutcome) -> Option<String> {
+    (outcome.reached < outcome.wanted).then(|| {
         format!(
-            "The arena is full: {reached} of {wanted} balls fit. Shrink the radii or enlarge \
-             the window."
+            "The arena is full: {} of {} balls fit. Shrink the radii or enlarge the window.",
+            outcome.reached, outcome.wanted
         )
-    });
-    world.insert_resource(BallCountNote(note));
-}
-
-/// Figures the panel shows, gathered every frame.
-#[derive(Resource, Debug, Default)]
-pub struct Readouts {
-    pub balls: usize,
-    pub kinetic_energy: f64,
-    pub momentum: DVec2,
-    pub collisions_per_second: f64,
-    /// Mean kinetic energy per ball.
-    pub temperature: f64,
-    /// Wall impulse per unit length and time over the last simulated second.
-    pub pressure: f64,
-    pub speed_histogram: SpeedHistogram,
-    /// (simulated seconds, kinetic energy) over the last 10 simulated seconds.
-    pub energy_history: VecDeque<[f64; 2]>,
-    /// Counters at moments within the last [`RATE_WINDOW_SECONDS`].
-    samples: VecDeque<CounterSample>,
-    /// (mass, speed) of every ball: the histogram's input, kept to reuse its memory.
-    speeds: Vec<(f64, f64)>,
-}
-
-/// [`SimStats`] counters at one moment, for rates over a window.
-#[derive(Clone, Copy, Debug)]
-struct CounterSample {
-    sim_time: f64,
-    ball_collisions: u64,
-    wall_impulse: f64,
-}
-
-fn update_readouts(
-    params: Res<SimParams>,
-    stats: Res<SimStats>,
-    balls: Query<(&Velocity, &Radius), With<Ball>>,
-    mut loaded: MessageReader<SceneLoaded>,
-    mut readouts: ResMut<Readouts>,
-) {
-    let mass_model = params.mass_model;
-    let (mut energy, mut momentum) = (0.0, DVec2::ZERO);
-    readouts.speeds.clear();
-    for (velocity, radius) in &balls {
-        let mass = mass_model.mass(radius.0);
-        energy += kinetic_energy(mass, velocity.0);
-        momentum += velocity.0 * mass;
-        readouts.speeds.push((mass, velocity.length()));
-    }
-    let now = stats.sim_time;
-    let readouts = &mut *readouts;
-    readouts.balls = balls.iter().len();
-    readouts.kinetic_energy = energy;
-    readouts.momentum = momentum;
-    readouts.temperature = if readouts.balls > 0 {
-        energy / readouts.balls as f64
-    } else {
-        0.0
-    };
-    readouts.speed_histogram = SpeedHistogram::measure(&readouts.speeds, SPEED_BINS);
-    if loaded.read().count() > 0 {
-        readouts.samples.clear();
-        readouts.energy_history.clear();
-    }
-    if readouts.samples.back().is_none_or(|s| s.sim_time < now) {
-        readouts.samples.push_back(CounterSample {
-            sim_time: now,
-            ball_collisions: stats.ball_collisions,
-            wall_impulse: stats.wall_impulse,
-        });
-    }
-    while readouts.samples.len() > 2 && readouts.samples[1].sim_time <= now - RATE_WINDOW_SECONDS {
-        readouts.samples.pop_front();
-    }
-    (readouts.collisions_per_second, readouts.pressure) =
-        match (readouts.samples.front(), readouts.samples.back()) {
-            (Some(first), Some(last)) if last.sim_time > first.sim_time => {
-                let elapsed = last.sim_time - first.sim_time;
-                let perimeter = 2.0 * (params.arena_size.x + params.arena_size.y);
-                (
-                    (last.ball_collisions - first.ball_collisions) as f64 / elapsed,
-                    if perimeter > 0.0 {
-                        (last.wall_impulse - first.wall_impulse) / (perimeter * elapsed)
-                    } else {
-                        0.0
-                    },
-                )
-            }
-            _ => (0.0, 0.0),
-        };
-    if readouts
-        .energy_history
-        .back()
-        .is_none_or(|&[t, _]| now - t >= PLOT_SAMPLE_SECONDS)
-    {
-        readouts.energy_history.push_back([now, energy]);
-    }
-    while readouts
-        .energy_history
-        .front()
-        .is_some_and(|&[t, _]| t < now - PLOT_SECONDS)
-    {
-        readouts.energy_history.pop_front();
-    }
+    })
 }
 
 /// Everything the panel edits.
 #[derive(SystemParam)]
 struct Tunables<'w> {
     params: ResMut<'w, SimParams>,
+    solver: ResMut<'w, Solver>,
+    run: ResMut<'w, RunControl>,
     spawn: ResMut<'w, SpawnSettings>,
     view: ResMut<'w, ViewSettings>,
     fixed: ResMut<'w, Time<Fixed>>,
-    pending: ResMut<'w, PendingSteps>,
 }
 
 /// Everything the panel only shows.
@@ -227,7 +85,7 @@ struct Shown<'w> {
     scenes: Res<'w, SceneList>,
     current: Res<'w, CurrentScene>,
     status: Res<'w, SceneStatus>,
-    ball_count_note: Res<'w, BallCountNote>,
+    ball_count: Res<'w, BallCountOutcome>,
 }
 
 fn draw_panel(
@@ -237,7 +95,7 @@ fn draw_panel(
     mut tunables: Tunables,
     shown: Shown,
     mut requests: MessageWriter<SceneRequest>,
-    mut commands: Commands,
+    mut intents: MessageWriter<Intent>,
 ) -> Result {
     let width = if visible.0 { PANEL_WIDTH } else { 0.0 };
     if play_area.panel_width != width {
@@ -274,7 +132,7 @@ fn draw_panel(
                 });
                 ui.label(RichText::new("Space pause · N step · R reset · H hide").small());
                 controls(ui, &mut tunables, &shown, &mut requests);
-                balls(ui, &mut tunables.spawn, &shown, &mut commands);
+                balls(ui, &mut tunables.spawn, &shown, &mut intents);
                 physics(ui, &mut tunables);
                 readouts(ui, &shown);
                 gas(ui, &shown.readouts);
@@ -291,17 +149,16 @@ fn controls(
     requests: &mut MessageWriter<SceneRequest>,
 ) {
     ui.horizontal(|ui| {
-        let label = if tunables.params.paused {
+        let label = if tunables.run.paused {
             "▶ Resume"
         } else {
             "⏸ Pause"
         };
         if ui.button(label).clicked() {
-            tunables.params.paused = !tunables.params.paused;
+            tunables.run.paused = !tunables.run.paused;
         }
         if ui.button("Step").clicked() {
-            tunables.params.paused = true;
-            tunables.pending.0 += 1;
+            tunables.run.step_once();
         }
         if ui.button("Reset").clicked() {
             requests.write(SceneRequest::Reset);
@@ -346,26 +203,29 @@ fn step_rate(slider_value: f64) -> f64 {
     if slider_value.is_finite() {
         slider_value.clamp(*STEP_RATE_SLIDER.start(), *STEP_RATE_SLIDER.end())
     } else {
-        crate::play::DEFAULT_STEP_RATE
+        DEFAULT_STEP_RATE
     }
 }
 
-fn balls(ui: &mut egui::Ui, spawn: &mut SpawnSettings, shown: &Shown, commands: &mut Commands) {
+fn balls(
+    ui: &mut egui::Ui,
+    spawn: &mut SpawnSettings,
+    shown: &Shown,
+    intents: &mut MessageWriter<Intent>,
+) {
     egui::CollapsingHeader::new("Balls")
         .default_open(true)
         .show(ui, |ui| {
-            let mut count = shown.readouts.balls;
+            let mut count = shown.readouts.summary.ball_count;
             let response = ui.add(
-                slider(&mut count, BALL_COUNT_RANGE)
+                slider(&mut count, BALL_COUNT_SLIDER)
                     .logarithmic(true)
                     .text("count"),
             );
             if response.changed() {
-                commands.queue(move |world: &mut World| {
-                    request_ball_count(world, count);
-                });
+                intents.write(Intent::SetBallCount(count));
             }
-            if let Some(note) = &shown.ball_count_note.0 {
+            if let Some(note) = ball_count_note(&shown.ball_count) {
                 ui.colored_label(Color32::from_rgb(255, 190, 90), note);
             }
             let mut edited = *spawn;
@@ -393,13 +253,15 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
         .default_open(true)
         .show(ui, |ui| {
             let mut edited = tunables.params.clone();
+            let mut solver = *tunables.solver;
+            let mut run = *tunables.run;
             ui.horizontal(|ui| {
                 ui.label("collisions");
                 for (mode, name) in CollisionMode::ALL
                     .into_iter()
                     .zip(["continuous", "discrete"])
                 {
-                    ui.radio_value(&mut edited.collisions, mode, name);
+                    ui.radio_value(&mut solver.collisions, mode, name);
                 }
             })
             .response
@@ -417,15 +279,22 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
                 }
             });
             ui.add(
-                slider(&mut edited.time_scale, TIME_SCALE_SLIDER)
+                slider(&mut run.time_scale, TIME_SCALE_SLIDER)
                     .logarithmic(true)
                     .smallest_positive(0.01)
                     .text("time scale"),
             );
             ui.add(slider(&mut edited.linear_damping, DAMPING_SLIDER).text("damping /s"));
             edited.clamp_to_limits();
+            run.clamp_to_limits();
             if edited != *tunables.params {
                 *tunables.params = edited;
+            }
+            if solver != *tunables.solver {
+                *tunables.solver = solver;
+            }
+            if run != *tunables.run {
+                *tunables.run = run;
             }
             let mut rate = 1.0 / tunables.fixed.timestep().as_secs_f64();
             if ui
@@ -472,12 +341,18 @@ fn readouts(ui: &mut egui::Ui, shown: &Shown) {
                         "simulation ms",
                         format!("{:.1}", simulation_ms.unwrap_or(0.0)),
                     ),
-                    ("balls", format!("{}", r.balls)),
+                    ("balls", format!("{}", r.summary.ball_count)),
                     ("collisions /s", format!("{:.0}", r.collisions_per_second)),
-                    ("kinetic energy", format!("{:.4e}", r.kinetic_energy)),
+                    (
+                        "kinetic energy",
+                        format!("{:.4e}", r.summary.kinetic_energy),
+                    ),
                     (
                         "momentum",
-                        format!("({:.3e}, {:.3e})", r.momentum.x, r.momentum.y),
+                        format!(
+                            "({:.3e}, {:.3e})",
+                            r.summary.momentum.x, r.summary.momentum.y
+                        ),
                     ),
                 ] {
                     ui.label(name);
@@ -505,7 +380,10 @@ fn gas(ui: &mut egui::Ui, readouts: &Readouts) {
         .show(ui, |ui| {
             egui::Grid::new("gas").num_columns(2).show(ui, |ui| {
                 for (name, value) in [
-                    ("temperature", format!("{:.4e}", readouts.temperature)),
+                    (
+                        "temperature",
+                        format!("{:.4e}", readouts.summary.temperature()),
+                    ),
                     ("pressure", format!("{:.4e}", readouts.pressure)),
                 ] {
                     ui.label(name);
@@ -513,7 +391,7 @@ fn gas(ui: &mut egui::Ui, readouts: &Readouts) {
                     ui.end_row();
                 }
             });
-            let histogram = &readouts.speed_histogram;
+            let histogram = &readouts.summary.speed_histogram;
             let width = histogram.bin_width;
             let bars = histogram
                 .counts
@@ -555,29 +433,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_slider_lies_within_what_the_simulation_accepts() {
-        use crate::sim::params::{
-            DAMPING_RANGE, MAX_BALLS, MAX_GRAVITY, MAX_SPEED, RADIUS_RANGE, TIME_SCALE_RANGE,
-        };
-        let within = |inner: &RangeInclusive<f64>, outer: &RangeInclusive<f64>| {
-            outer.contains(inner.start()) && outer.contains(inner.end())
-        };
-        assert!(within(&RADIUS_SLIDER, &RADIUS_RANGE));
-        assert!(within(&SPEED_SLIDER, &(0.0..=MAX_SPEED)));
-        assert!(within(&GRAVITY_SLIDER, &(-MAX_GRAVITY..=MAX_GRAVITY)));
-        assert!(within(&TIME_SCALE_SLIDER, &TIME_SCALE_RANGE));
-        assert!(within(&DAMPING_SLIDER, &DAMPING_RANGE));
-        assert!(*STEP_RATE_SLIDER.start() > 0.0);
-        assert!(*BALL_COUNT_RANGE.end() <= MAX_BALLS);
-    }
-
-    #[test]
     fn a_typed_step_rate_is_bounded_and_not_a_number_gives_the_default() {
         assert_eq!(step_rate(120.0), 120.0);
         assert_eq!(step_rate(1e9), *STEP_RATE_SLIDER.end());
         assert_eq!(step_rate(0.0), *STEP_RATE_SLIDER.start());
         assert_eq!(step_rate(-5.0), *STEP_RATE_SLIDER.start());
-        assert_eq!(step_rate(f64::NAN), crate::play::DEFAULT_STEP_RATE);
-        assert_eq!(step_rate(f64::INFINITY), crate::play::DEFAULT_STEP_RATE);
+        assert_eq!(step_rate(f64::NAN), DEFAULT_STEP_RATE);
+        assert_eq!(step_rate(f64::INFINITY), DEFAULT_STEP_RATE);
     }
 }

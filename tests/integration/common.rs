@@ -7,19 +7,33 @@ use bevy::prelude::*;
 /// The fixed step every test uses, seconds.
 pub const DT: f64 = 1.0 / 60.0;
 
-/// A headless app with `params` and these balls (ids in the given order); no step run yet.
+/// A headless app in the default (continuous) mode with `params` and these balls (ids in the
+/// given order); no step run yet.
 pub fn app_with(params: SimParams, balls: &[BallState]) -> App {
+    app_in(CollisionMode::default(), params, balls)
+}
+
+/// [`app_with`] in collision mode `mode`.
+pub fn app_in(mode: CollisionMode, params: SimParams, balls: &[BallState]) -> App {
     let mut app = headless_app(DT);
     let setup = SceneSetup {
-        params: params.clone(),
-        collisions: Some(params.collisions),
+        params,
+        collisions: Some(mode),
         balls: balls.to_vec(),
         rng: ballpit::sim::SimRng::default().0,
     };
     setup.apply(app.world_mut());
-    // `apply` keeps the pause state and broad phase already chosen; tests want all of `params`.
-    app.insert_resource(params);
     app
+}
+
+/// Pauses or resumes `app`.
+pub fn set_paused(app: &mut App, paused: bool) {
+    app.world_mut().resource_mut::<RunControl>().paused = paused;
+}
+
+/// Steps run since the scene was loaded.
+pub fn steps_run(app: &App) -> u64 {
+    app.world().resource::<SimClock>().steps
 }
 
 pub fn ball(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> BallState {
@@ -93,5 +107,5 @@ pub fn record_collisions(app: &mut App) {
         recorded.wall_hits.extend(walls.read().copied());
     }
     app.init_resource::<Recorded>()
-        .add_systems(FixedUpdate, record.after(SimSystems::Response));
+        .add_systems(FixedUpdate, record.after(SimulationStep));
 }

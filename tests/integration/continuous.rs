@@ -5,12 +5,11 @@ use ballpit::prelude::*;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::common::{DT, Recorded, app_with, ball, record_collisions, shipped_scene, states, step};
+use crate::common::{DT, Recorded, app_in, ball, record_collisions, shipped_scene, states, step};
 
-fn params(mode: CollisionMode, width: f64, height: f64) -> SimParams {
+fn arena(width: f64, height: f64) -> SimParams {
     SimParams {
         arena_size: DVec2::new(width, height),
-        collisions: mode,
         ..default()
     }
 }
@@ -27,7 +26,7 @@ fn head_on_at_20_diameters_per_step_bounces_where_discrete_tunnels() {
         ball(-100.0, 0.0, v, 0.0, 5.0),
         ball(100.0, 0.0, -v, 0.0, 5.0),
     ];
-    let mut app = app_with(params(CollisionMode::Continuous, 2000.0, 200.0), &balls);
+    let mut app = app_in(CollisionMode::Continuous, arena(2000.0, 200.0), &balls);
     record_collisions(&mut app);
     step(&mut app, 1);
     let [a, b] = states(&mut app)[..] else {
@@ -50,7 +49,7 @@ fn head_on_at_20_diameters_per_step_bounces_where_discrete_tunnels() {
     assert!((a.velocity.x + v).abs() < 1e-9 && (b.velocity.x - v).abs() < 1e-9);
 
     // The tutorial's method only looks at the end of the step and misses the hit.
-    let mut app = app_with(params(CollisionMode::Discrete, 2000.0, 200.0), &balls);
+    let mut app = app_in(CollisionMode::Discrete, arena(2000.0, 200.0), &balls);
     step(&mut app, 1);
     let [a, b] = states(&mut app)[..] else {
         panic!("two balls")
@@ -64,8 +63,9 @@ fn head_on_at_20_diameters_per_step_bounces_where_discrete_tunnels() {
 #[test]
 fn a_ball_at_20_diameters_per_step_stays_in_the_arena_and_keeps_its_speed() {
     let v = speed(20.0, 5.0);
-    let mut app = app_with(
-        params(CollisionMode::Continuous, 400.0, 300.0),
+    let mut app = app_in(
+        CollisionMode::Continuous,
+        arena(400.0, 300.0),
         &[ball(0.0, 0.0, v, v * 0.37, 5.0)],
     );
     record_collisions(&mut app);
@@ -100,7 +100,7 @@ fn balls_on_a_line_at_up_to_10_diameters_per_step_never_pass_each_other() {
             ball(-450.0 + i as f64 * 100.0, 0.0, v, 0.0, 4.0 + (i % 3) as f64)
         })
         .collect();
-    let mut app = app_with(params(CollisionMode::Continuous, 1000.0, 100.0), &balls);
+    let mut app = app_in(CollisionMode::Continuous, arena(1000.0, 100.0), &balls);
     for step_index in 0..300 {
         step(&mut app, 1);
         let now = states(&mut app);
@@ -119,11 +119,9 @@ fn newtons_cradle_passes_the_speed_to_the_last_ball() {
     let setup = shipped_scene("newtons_cradle.ron")
         .build("newtons_cradle.ron")
         .unwrap();
-    let mut app = app_with(
-        SimParams {
-            collisions: CollisionMode::Continuous,
-            ..setup.params.clone()
-        },
+    let mut app = app_in(
+        CollisionMode::Continuous,
+        setup.params.clone(),
         &setup.balls,
     );
     // The first ball reaches the row after 260 px at 300 px/s: 52 steps; run a little more.
@@ -141,11 +139,9 @@ fn newtons_cradle_passes_the_speed_to_the_last_ball() {
 fn standard_gas_keeps_its_energy_to_one_part_in_a_million() {
     let setup = shipped_scene("gas.ron").build("gas.ron").unwrap();
     assert_eq!(setup.balls.len(), 1000);
-    let mut app = app_with(
-        SimParams {
-            collisions: CollisionMode::Continuous,
-            ..setup.params.clone()
-        },
+    let mut app = app_in(
+        CollisionMode::Continuous,
+        setup.params.clone(),
         &setup.balls,
     );
     let start = StateSummary::measure(app.world_mut());
@@ -192,7 +188,7 @@ fn three_balls_meeting_in_one_step_end_the_same_whatever_the_order_found() {
             .map(|&i| chain[i])
             .chain(order.iter().map(|&i| pinch[i]))
             .collect();
-        let mut app = app_with(params(CollisionMode::Continuous, 400.0, 400.0), &balls);
+        let mut app = app_in(CollisionMode::Continuous, arena(400.0, 400.0), &balls);
         step(&mut app, 1);
         let after = states(&mut app);
         // Back to the canonical order.
@@ -252,9 +248,8 @@ fn a_collapsing_pile_is_cut_short_yet_stays_finite_and_inside() {
     let mut params = setup.params.clone();
     params.gravity = DVec2::new(300.0, -2000.0);
     params.restitution = 0.5;
-    params.collisions = CollisionMode::Continuous;
     let half = params.half_extents();
-    let mut app = app_with(params, &setup.balls);
+    let mut app = app_in(CollisionMode::Continuous, params, &setup.balls);
     step(&mut app, 90);
     assert!(app.world().resource::<SimStats>().cut_short_steps > 0);
     for b in states(&mut app) {

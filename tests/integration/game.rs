@@ -1,8 +1,14 @@
 //! The windowed toy's plugins, built and run without a window or GPU: a broken plugin setup
 //! (a missing resource, a bad schedule) fails here rather than on a player's screen.
 
-use ballpit::play::{CurrentScene, GamePlugin, SceneRequest};
+use ballpit::app::scenes::{CurrentScene, SceneRequest, SceneStatus};
+use ballpit::app::view::{PANEL_WIDTH, PanelVisible, PlayArea};
+use ballpit::play::GamePlugin;
 use ballpit::prelude::*;
+use ballpit::sim::BallCountOutcome;
+use ballpit::ui::panel::ball_count_note;
+use bevy::input::ButtonState;
+use bevy::input::keyboard::{Key, KeyboardInput, NativeKey};
 use bevy::prelude::*;
 use bevy::render::RenderPlugin;
 use bevy::render::settings::{RenderCreation, WgpuSettings};
@@ -85,7 +91,7 @@ fn the_game_builds_loads_its_scene_and_steps_without_a_window() {
     assert_eq!(balls, 40, "every ball of the demo has a sprite");
     let step = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     assert!((step - 1.0 / 60.0).abs() < 1e-9, "{step}");
-    assert!(world.resource::<SimStats>().steps >= 2);
+    assert!(world.resource::<SimClock>().steps >= 2);
 }
 
 #[test]
@@ -97,7 +103,7 @@ fn a_bad_scene_request_keeps_the_current_scene_and_reports() {
     app.update();
     app.update();
     let world = app.world_mut();
-    let status = world.resource::<ballpit::play::SceneStatus>().0.clone();
+    let status = world.resource::<SceneStatus>().0.clone();
     assert!(status.unwrap().contains("no_such_scene.ron"));
     assert_eq!(
         world.query_filtered::<(), With<Ball>>().iter(world).count(),
@@ -114,8 +120,8 @@ fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
     app.update();
     resize_window(&mut app, window, (1400.0, 900.0), 3);
     // The gas (1,083 px square) is taller than the largest window: shown zoomed out.
-    let panel = ballpit::ui::PANEL_WIDTH as f64;
-    let zoom = app.world().resource::<ballpit::render::PlayArea>().zoom as f64;
+    let panel = PANEL_WIDTH as f64;
+    let zoom = app.world().resource::<PlayArea>().zoom as f64;
     assert!(zoom > 1.0 && zoom < 1.1, "zoom {zoom}");
     let arena = app.world().resource::<SimParams>().arena_size;
     let expected = bevy::math::DVec2::new(1400.0 - panel, 900.0) * zoom;
@@ -135,10 +141,10 @@ fn a_minimised_window_keeps_the_arena_and_every_ball() {
         app.update();
     }
     let arena = app.world().resource::<SimParams>().arena_size;
-    let steps = app.world().resource::<SimStats>().steps;
+    let steps = steps_run(&app);
     resize_window(&mut app, window, (0.0, 0.0), 5);
     assert_eq!(app.world().resource::<SimParams>().arena_size, arena);
-    assert!(app.world().resource::<SimStats>().steps >= steps + 4);
+    assert!(steps_run(&app) >= steps + 4);
     assert_eq!(states(&mut app).len(), 40);
     assert_all_inside(&mut app);
 }
@@ -147,26 +153,74 @@ fn a_minimised_window_keeps_the_arena_and_every_ball() {
 fn asking_for_more_balls_than_fit_gives_a_note_not_a_hang() {
     let mut app = windowless_game("demo.ron");
     app.update();
+    app.world_mut()
+        .resource_mut::<ballpit::sim::SpawnSettings>()
+        .radius = (40.0, 40.0);
+    // The count slider sends this; the fixed step applies it.
+    app.world_mut().write_message(Intent::SetBallCount(100_000));
+    app.update();
     let world = app.world_mut();
-    world.resource_mut::<ballpit::sim::SpawnSettings>().radius = (40.0, 40.0);
-    let started = std::time::Instant::now();
-    ballpit::ui::panel::request_ball_count(world, 100_000);
     let balls = world.query_filtered::<(), With<Ball>>().iter(world).count();
-    let note = world
-        .resource::<ballpit::ui::panel::BallCountNote>()
-        .0
-        .clone();
+    let note = ball_count_note(world.resource::<BallCountOutcome>());
     assert!(balls > 40 && balls < 1_000, "{balls}");
     let note = note.expect("a note when the arena is full");
     assert!(
         note.contains(&format!("{balls} of 100000 balls fit")),
         "{note}"
     );
-    assert!(started.elapsed().as_secs() < 30);
     // A request that is met clears it.
-    ballpit::ui::panel::request_ball_count(world, 10);
+    app.world_mut().write_message(Intent::SetBallCount(10));
+    app.update();
     assert_eq!(
-        world.resource::<ballpit::ui::panel::BallCountNote>().0,
+        ball_count_note(app.world().resource::<BallCountOutcome>()),
         None
     );
+}
+
+/// Presses `key` for one frame and releases it, as the window's keyboard messages would:
+/// Bevy's input plugin turns them into `ButtonInput<KeyCode>`, which the toy reads.
+fn press(app: &mut App, key: KeyCode) {
+    for state in [ButtonState::Pressed, ButtonState::Released] {
+        app.world_mut().write_message(KeyboardInput {
+            key_code: key,
+            logical_key: Key::Unidentified(NativeKey::Unidentified),
+            state,
+            text: None,
+            repeat: false,
+            window: Entity::PLACEHOLDER,
+        });
+        app.update();
+    }
+}
+
+#[test]
+fn the_keys_pause_step_hide_and_reset() {
+    let mut app = windowless_game("demo.ron");
+    app.update();
+    app.update();
+    // Space pauses: no more steps run.
+    press(&mut app, KeyCode::Space);
+    assert!(app.world().resource::<RunControl>().paused);
+    let paused_at = steps_run(&app);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(steps_run(&app), paused_at);
+    // N runs exactly one step and stays paused.
+    press(&mut app, KeyCode::KeyN);
+    assert_eq!(steps_run(&app), paused_at + 1);
+    assert!(app.world().resource::<RunControl>().paused);
+    // H hides the panel, and again shows it.
+    press(&mut app, KeyCode::KeyH);
+    assert!(!app.world().resource::<PanelVisible>().0);
+    press(&mut app, KeyCode::KeyH);
+    assert!(app.world().resource::<PanelVisible>().0);
+    // R reloads the scene: the clock starts again.
+    press(&mut app, KeyCode::KeyR);
+    assert_eq!(steps_run(&app), 0);
+    // Space again resumes.
+    press(&mut app, KeyCode::Space);
+    app.update();
+    assert!(!app.world().resource::<RunControl>().paused);
+    assert!(steps_run(&app) > 0);
 }

@@ -1,9 +1,11 @@
 //! The integration tests: one crate, so one link. Headless apps under `MinimalPlugins`, each
-//! `update()` exactly one fixed step (see `common`).
+//! `update()` exactly one fixed step (see `common`); `game` builds the whole toy without a
+//! window (with the default `gui` feature only).
 
 mod cli;
 mod common;
 mod continuous;
+#[cfg(feature = "gui")]
 mod game;
 mod physics;
 mod scenes;

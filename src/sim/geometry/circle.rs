@@ -1,8 +1,9 @@
-//! Narrow phase: the exact circle–circle tests, as pure functions over plain values.
+//! Circles: the exact circle–circle tests (AABB, squared distance, contact, collision point,
+//! time of impact), as pure functions over plain values.
 //!
-//! Runs inside the collision stage (`detect_contacts`) for every candidate pair the broad
-//! phase proposes, and again wherever a prediction must match the simulation exactly (tests,
-//! the aiming guide).
+//! Both modes' collision stages call them for every candidate pair the grid proposes; the
+//! aiming guide, scene placement and the measurements call the same ones, so every prediction
+//! matches the simulation exactly.
 
 use bevy::math::DVec2;
 
@@ -54,6 +55,29 @@ pub fn collision_point(a: Circle, b: Circle) -> DVec2 {
 /// pair apart along it.
 pub const COINCIDENT_NORMAL: DVec2 = DVec2::X;
 
+/// Two circles overlap when they interpenetrate by more than this fraction of their radii
+/// sum: less is rounding. So hand-written decimals that touch (Newton's cradle) are accepted,
+/// and a pair left touching by a time of impact is not pushed apart again.
+pub const OVERLAP_TOLERANCE: f64 = 1e-9;
+
+/// Whether two circles overlap by more than rounding ([`OVERLAP_TOLERANCE`]).
+#[inline]
+pub fn overlapping(a: Circle, b: Circle) -> bool {
+    let reach = (a.radius + b.radius) * (1.0 - OVERLAP_TOLERANCE);
+    a.center.distance_squared(b.center) < reach * reach
+}
+
+/// The unit normal along `offset`, the vector from one centre to the other, whose length is
+/// `distance`: [`COINCIDENT_NORMAL`] when the centres coincide.
+#[inline]
+pub fn contact_normal(offset: DVec2, distance: f64) -> DVec2 {
+    if distance > 0.0 {
+        offset / distance
+    } else {
+        COINCIDENT_NORMAL
+    }
+}
+
 /// Both tests at once, without an early exit: the AABB test and the squared-distance test are
 /// each a few flops, and in a hot loop where about half the candidates pass the AABB test a
 /// branch on it mispredicts often. True when the circles touch or overlap.
@@ -79,17 +103,17 @@ pub fn circle_contact(a: Circle, b: Circle) -> Option<ContactGeometry> {
         return None;
     }
     let distance = distance_squared.sqrt();
-    let normal = if distance > 0.0 {
-        delta / distance
-    } else {
-        COINCIDENT_NORMAL
-    };
     Some(ContactGeometry {
-        normal,
+        normal: contact_normal(delta, distance),
         depth: reach - distance,
         point: collision_point(a, b),
     })
 }
+
+/// Pairs (and balls and walls) closing more slowly than this, pixels per second, count as
+/// resting, not approaching. Without it, rounding after a perfectly inelastic hit could
+/// schedule the same impact again and again at the same instant.
+pub const MIN_APPROACH_SPEED: f64 = 1e-9;
 
 /// Seconds until two circles moving at constant velocities first touch, or `None` if they
 /// never do. Pairs that already touch count as touching now (`Some(0.0)`) only while they

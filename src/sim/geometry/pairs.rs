@@ -1,59 +1,14 @@
-//! Stage 2, collision: find every touching pair and record it as a [`Contact`].
-//!
-//! Runs in [`SimSystems::Collision`](super::SimSystems::Collision), after movement and before
-//! response, on the contiguous [`BallSnapshot`] the movement stage wrote: the broad phase
-//! proposes candidate pairs, the narrow phase's AABB test and exact squared-distance test keep
-//! the touching ones. Writes [`Contacts`]; changes no ball.
-
-pub mod broad_phase;
-pub mod narrow_phase;
+//! Touching pairs: the grid's candidate pairs put through the exact circle test, each pair
+//! once, in an order fixed by the input whatever the number of threads. The discrete mode's
+//! detection, the continuous mode's fallback and the overlap measurement use it.
 
 use std::ops::Range;
 
-use bevy::math::DVec2;
-use bevy::prelude::*;
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
-use super::SimSystems;
-use super::ball::BallSnapshot;
-use super::continuous::in_mode;
-use super::params::{BroadPhase, CollisionMode, SimParams};
-use broad_phase::{UniformGrid, for_each_pair};
-use narrow_phase::{Circle, ContactGeometry, circle_contact, circles_touch};
-
-pub(super) fn plugin(app: &mut App) {
-    app.init_resource::<Contacts>()
-        .init_resource::<CollisionScratch>()
-        .add_systems(
-            FixedUpdate,
-            detect_contacts
-                .in_set(SimSystems::Collision)
-                .run_if(in_mode(CollisionMode::Discrete)),
-        );
-}
-
-/// Two balls in contact this step. In discrete mode: a pair touching or overlapping after
-/// the movement, found by the collision stage. In continuous mode: a pair at its moment of
-/// impact (depth zero), recorded by the response stage as it handles the impact.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Contact {
-    pub a: Entity,
-    pub b: Entity,
-    /// Where `a` and `b` sit in this step's [`BallSnapshot`].
-    pub index_a: u32,
-    pub index_b: u32,
-    /// Unit vector from `a`'s centre towards `b`'s.
-    pub normal: DVec2,
-    /// Overlap along the normal, pixels.
-    pub depth: f64,
-    /// The radius-weighted collision point, pixels.
-    pub point: DVec2,
-}
-
-/// This step's contacts, in a stable order: in discrete mode the response processes them in
-/// this order; in continuous mode they are the impacts in the order handled.
-#[derive(Resource, Debug, Default)]
-pub struct Contacts(pub Vec<Contact>);
+use super::circle::{Circle, ContactGeometry, circle_contact, circles_touch};
+use super::grid::{UniformGrid, for_each_pair};
+use crate::sim::params::BroadPhase;
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,34 +88,6 @@ fn keep_touching(found: &mut Vec<IndexedContact>) -> impl FnMut(u32, u32, Circle
             found.push(IndexedContact { a, b, geometry });
         }
     }
-}
-
-/// Buffers the collision stage keeps between steps.
-#[derive(Resource, Default)]
-struct CollisionScratch {
-    grid: UniformGrid,
-    found: Vec<IndexedContact>,
-}
-
-fn detect_contacts(
-    params: Res<SimParams>,
-    snapshot: Res<BallSnapshot>,
-    mut scratch: ResMut<CollisionScratch>,
-    mut contacts: ResMut<Contacts>,
-) {
-    let CollisionScratch { grid, found } = &mut *scratch;
-    found.clear();
-    find_contacts(&snapshot.circles, params.broad_phase, grid, found);
-    contacts.0.clear();
-    contacts.0.extend(found.iter().map(|contact| Contact {
-        a: snapshot.entities[contact.a as usize],
-        b: snapshot.entities[contact.b as usize],
-        index_a: contact.a,
-        index_b: contact.b,
-        normal: contact.geometry.normal,
-        depth: contact.geometry.depth,
-        point: contact.geometry.point,
-    }));
 }
 
 #[cfg(test)]

@@ -9,19 +9,25 @@
 
 use std::error::Error;
 use std::process::Command;
-use std::time::Instant;
 
-use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::cli::{BroadPhaseArg, CollisionsArg, flag_value};
-use crate::headless::{DEFAULT_DT, headless_app_with_threads, median};
-use crate::sim::{BroadPhase, CollisionMode, Contacts, SceneFile, SimParams, SimStats};
+use crate::headless::{DEFAULT_DT, headless_app_with_threads, median, time_steps};
+use crate::sim::{BroadPhase, CollisionMode, ContactPoints, SceneFile, SimStats, Solver};
 
 /// The standard gas, built in so the bench runs from any directory.
-pub const STANDARD_GAS: &str = include_str!("../assets/scenes/gas.ron");
+pub const STANDARD_GAS: &str = include_str!("../../assets/scenes/gas.ron");
 /// Steps run before timing starts (first-touch allocations, caches).
 const WARM_UP_STEPS: u64 = 5;
+
+/// The text that the command line parses back to `value` (for the bench's children).
+pub fn flag_value(value: impl clap::ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .expect("no flag value is hidden")
+        .get_name()
+        .to_string()
+}
 
 /// One case: how many balls, how many timed steps, which broad phase and collision mode.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -63,21 +69,16 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
     let setup = scene.build("gas.ron")?;
     let mut app = headless_app_with_threads(DEFAULT_DT, Some(threads));
     setup.apply(app.world_mut());
-    let mut params = app.world_mut().resource_mut::<SimParams>();
-    params.broad_phase = case.broad_phase;
-    params.collisions = case.collisions;
-    for _ in 0..WARM_UP_STEPS {
-        app.update();
-    }
+    app.insert_resource(Solver {
+        collisions: case.collisions,
+        broad_phase: case.broad_phase,
+    });
+    time_steps(&mut app, WARM_UP_STEPS, |_| {});
     let collisions_before = app.world().resource::<SimStats>().ball_collisions;
-    let mut step_ms = Vec::with_capacity(case.steps as usize);
     let mut contacts = 0usize;
-    for _ in 0..case.steps {
-        let started = Instant::now();
-        app.update();
-        step_ms.push(started.elapsed().as_secs_f64() * 1e3);
-        contacts += app.world().resource::<Contacts>().0.len();
-    }
+    let mut step_ms = time_steps(&mut app, case.steps, |app| {
+        contacts += app.world().resource::<ContactPoints>().0.len();
+    });
     let total_ms: f64 = step_ms.iter().sum();
     let collisions =
         (app.world().resource::<SimStats>().ball_collisions - collisions_before) as f64;
@@ -132,11 +133,11 @@ pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, 
         ])
         .args([
             "--broad-phase",
-            &flag_value(BroadPhaseArg::from(case.broad_phase)),
+            &flag_value(case.broad_phase),
             "--threads",
             &threads.to_string(),
             "--collisions",
-            &flag_value(CollisionsArg::from(case.collisions)),
+            &flag_value(case.collisions),
         ])
         .output()
         .map_err(|e| {
@@ -254,4 +255,28 @@ pub fn format_table(rows: &[BenchRow]) -> String {
         );
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    use super::*;
+
+    #[test]
+    fn flag_values_parse_back_to_the_same_modes() {
+        for mode in CollisionMode::ALL {
+            let text = flag_value(mode);
+            assert_eq!(CollisionMode::from_str(&text, false), Ok(mode), "{text}");
+        }
+        for broad_phase in [BroadPhase::Grid, BroadPhase::AllPairs] {
+            let text = flag_value(broad_phase);
+            assert_eq!(
+                BroadPhase::from_str(&text, false),
+                Ok(broad_phase),
+                "{text}"
+            );
+        }
+        assert_eq!(flag_value(BroadPhase::AllPairs), "all-pairs");
+    }
 }

@@ -1,33 +1,13 @@
-//! Stage 3, response: for each contact, the elastic exchange along the line of centres, then
-//! separation so nothing sticks; finally the walls again for the separated balls, since
-//! separation may push a ball into a wall.
+//! Impulses: the momentum a hit exchanges along the contact normal, between two balls or
+//! between a ball and a wall, and the separation of an overlapping pair shared by inverse
+//! mass. Pure functions over plain values.
 //!
-//! Runs in [`SimSystems::Response`](super::SimSystems::Response), reading [`Contacts`] in
-//! their stable order (Gauss–Seidel: each contact sees the velocities the earlier ones left).
-//! Works on the contiguous [`BallSnapshot`] by index, then writes the balls that changed back
-//! to their components in one pass. Writes a [`BallCollision`] per exchange.
+//! Both modes' responses, the aiming guide and the property tests call these, so the impulse
+//! is written once.
 
 use bevy::math::DVec2;
-use bevy::prelude::*;
 
-use super::ball::{Ball, BallSnapshot, Position, Velocity};
-use super::collision::Contacts;
-use super::collision::narrow_phase::{Circle, ContactGeometry, circle_contact};
-use super::continuous::in_mode;
-use super::messages::{BallCollision, WallCollision};
-use super::movement::{contain_in_arena, wall_collisions};
-use super::params::{CollisionMode, MassModel, SimParams};
-use super::stats::SimStats;
-use super::{SimSystems, step_seconds};
-
-pub(super) fn plugin(app: &mut App) {
-    app.add_systems(
-        FixedUpdate,
-        resolve_contacts
-            .in_set(SimSystems::Response)
-            .run_if(in_mode(CollisionMode::Discrete)),
-    );
-}
+use super::circle::{Circle, ContactGeometry};
 
 /// The result of [`normal_exchange`]: the new velocities and what the hit carried.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -86,47 +66,6 @@ pub fn separation_shares(depth: f64, inverse_mass_a: f64, inverse_mass_b: f64) -
     )
 }
 
-/// The discrete response on plain arrays: for each pair `(a, b)` of indices, in order, that
-/// still touches where the earlier pairs left it, the exchange along the normal (if the balls
-/// approach; `on_exchange` hears of it) and then separation shared by inverse mass. Both
-/// collision modes use it: discrete for every contact, continuous for a step it cut short.
-pub fn resolve_overlaps(
-    pairs: impl IntoIterator<Item = (u32, u32)>,
-    circles: &mut [Circle],
-    velocities: &mut [DVec2],
-    mass_model: MassModel,
-    restitution: f64,
-    mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
-) {
-    for (a, b) in pairs {
-        let (ia, ib) = (a as usize, b as usize);
-        // Earlier pairs may have moved either ball: work from where they are now.
-        let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
-            continue;
-        };
-        let inverse_mass_a = mass_model.inverse_mass(circles[ia].radius);
-        let inverse_mass_b = mass_model.inverse_mass(circles[ib].radius);
-        if let Some(exchange) = normal_exchange(
-            velocities[ia],
-            velocities[ib],
-            inverse_mass_a,
-            inverse_mass_b,
-            geometry.normal,
-            restitution,
-        ) {
-            velocities[ia] = exchange.velocity_a;
-            velocities[ib] = exchange.velocity_b;
-            on_exchange(a, b, geometry, exchange);
-        }
-        separate(
-            circles,
-            (ia, ib),
-            geometry,
-            (inverse_mass_a, inverse_mass_b),
-        );
-    }
-}
-
 /// Moves circles `a` and `b` apart along the contact normal by the contact's depth, shared by
 /// inverse mass ([`separation_shares`]).
 #[inline]
@@ -141,110 +80,11 @@ pub fn separate(
     circles[b].center += geometry.normal * forward;
 }
 
-fn resolve_contacts(
-    time: Res<Time>,
-    stats: Res<SimStats>,
-    contacts: Res<Contacts>,
-    params: Res<SimParams>,
-    mut snapshot: ResMut<BallSnapshot>,
-    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
-    mut collisions: MessageWriter<BallCollision>,
-    mut wall_hits: MessageWriter<WallCollision>,
-    mut in_contact: Local<Vec<bool>>,
-) {
-    if contacts.0.is_empty() {
-        return;
-    }
-    // Discrete mode sees a hit only at the end of the step, as an overlap.
-    let step_end = stats.sim_time + step_seconds(&time, &params);
-    let BallSnapshot {
-        entities,
-        circles,
-        velocities,
-    } = &mut *snapshot;
-    in_contact.clear();
-    in_contact.resize(entities.len(), false);
-    for contact in &contacts.0 {
-        (
-            in_contact[contact.index_a as usize],
-            in_contact[contact.index_b as usize],
-        ) = (true, true);
-    }
-    let pairs = contacts.0.iter().map(|c| (c.index_a, c.index_b));
-    let (mass_model, restitution) = (params.mass_model, params.restitution);
-    resolve_overlaps(
-        pairs,
-        circles,
-        velocities,
-        mass_model,
-        restitution,
-        |a, b, geometry, exchange| {
-            collisions.write(BallCollision {
-                a: entities[a as usize],
-                b: entities[b as usize],
-                time: step_end,
-                point: geometry.point,
-                normal: geometry.normal,
-                impulse: exchange.impulse,
-                normal_speed: exchange.closing_speed,
-            });
-        },
-    );
-    // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
-    // the movement stage kept every ball inside, so only they need the walls again, and only
-    // they are written back.
-    let half = params.half_extents();
-    let mut settle = |index: usize| {
-        let circle = circles[index];
-        let contained = contain_in_arena(
-            circle.center,
-            velocities[index],
-            circle.radius,
-            half,
-            params.restitution,
-        );
-        if contained.hits != [None, None] {
-            wall_hits.write_batch(wall_collisions(
-                entities[index],
-                &contained,
-                circle.radius,
-                &params,
-                step_end,
-            ));
-        }
-        (contained.position, contained.velocity)
-    };
-    write_back(entities, &mut balls, |index| {
-        in_contact[index].then(|| settle(index))
-    });
-}
-
-/// Writes each ball's new `(position, velocity)` from `new_state(index)`, where `index` is
-/// its place in the snapshot's `entities`; `None` leaves the ball as it is. The query visits
-/// the balls in the snapshot's order (nothing spawns or despawns within a step); should that
-/// ever not hold, the rest are looked up by entity.
-pub(super) fn write_back(
-    entities: &[Entity],
-    balls: &mut Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
-    mut new_state: impl FnMut(usize) -> Option<(DVec2, DVec2)>,
-) {
-    let mut matched = 0;
-    for (index, (entity, mut position, mut velocity)) in balls.iter_mut().enumerate() {
-        if entities.get(index) != Some(&entity) {
-            break;
-        }
-        matched = index + 1;
-        if let Some(state) = new_state(index) {
-            (position.0, velocity.0) = state;
-        }
-    }
-    for (index, &entity) in entities.iter().enumerate().skip(matched) {
-        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity)
-            && let Some(state) = new_state(index)
-        {
-            (position.0, velocity.0) = state;
-        }
-    }
+/// The impulse a wall gives a ball of `mass` arriving at `normal_speed` with restitution
+/// `restitution`: its normal momentum reversed and scaled, `m (1 + e) v_n`.
+#[inline]
+pub fn wall_impulse(mass: f64, restitution: f64, normal_speed: f64) -> f64 {
+    mass * (1.0 + restitution) * normal_speed
 }
 
 #[cfg(test)]

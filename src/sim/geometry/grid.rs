@@ -1,13 +1,13 @@
 //! Broad phase: which pairs of balls might touch, before the exact test.
 //!
-//! Runs inside the collision stage (`detect_contacts`, and the continuous mode's impact
-//! prediction, which sorts swept circles and also queries boxes). Two methods find the same pairs:
-//! [`UniformGrid`], O(N), the default, and [`for_each_pair`], O(N^2), kept as the reference the
-//! grid is tested against.
+//! Used by both modes' collision stages (the discrete mode sorts the balls' circles, the
+//! continuous mode the circles they sweep over the step, and also queries boxes). Two methods
+//! find the same pairs: [`UniformGrid`], O(N), the default, and [`for_each_pair`], O(N^2), kept
+//! as the reference the grid is tested against.
 
 use bevy::math::DVec2;
 
-use super::narrow_phase::Circle;
+use super::circle::Circle;
 
 /// The grid never has more cells than this many per ball, so a few tiny balls in a huge
 /// arena cost little memory; the cells grow instead.

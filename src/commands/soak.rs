@@ -17,14 +17,14 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::headless::headless_app;
-use crate::sim::params::{ARENA_SIDE_RANGE, RESTITUTION_RANGE};
-use crate::sim::stats::kinetic_energy;
-use crate::sim::{
-    Ball, CollisionMode, MassModel, Position, Radius, SceneFile, SceneSetup, SimParams, Velocity,
+use crate::sim::measure::summary::kinetic_energy;
+use crate::sim::params::{
+    ARENA_SIDE_RANGE, DAMPING_SLIDER, GRAVITY_SLIDER, RADIUS_SLIDER, RESTITUTION_RANGE,
+    SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
 };
-use crate::ui::panel::{
-    DAMPING_SLIDER, GRAVITY_SLIDER, RADIUS_SLIDER, SPEED_SLIDER, STEP_RATE_SLIDER,
-    TIME_SCALE_SLIDER,
+use crate::sim::{
+    Ball, CollisionMode, MassModel, Position, Radius, RunControl, SceneFile, SceneSetup, SimParams,
+    Solver, Velocity,
 };
 
 /// The densest covered fraction asked of random placement (it stalls a little above 0.5).
@@ -255,7 +255,7 @@ pub fn soak_scene(soak: &SoakScene, setup: &SceneSetup, steps: u64) -> SoakOutco
     let result = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {
         let mut app = headless_app(soak.dt);
         setup.apply(app.world_mut());
-        app.world_mut().resource_mut::<SimParams>().time_scale = soak.time_scale;
+        app.world_mut().resource_mut::<RunControl>().time_scale = soak.time_scale;
         let scene_arena = setup.params.arena_size;
         let mut rng = ChaCha8Rng::seed_from_u64(soak.seed ^ 0x5eed);
         read_balls(app.world_mut(), &mut balls);
@@ -271,21 +271,22 @@ pub fn soak_scene(soak: &SoakScene, setup: &SceneSetup, steps: u64) -> SoakOutco
                 app.world_mut().resource_mut::<SimParams>().arena_size = scene_arena;
                 restore_at = None;
             } else if restore_at.is_none() && rng.random_range(0..STEPS_PER_ACTION) == 0 {
-                let mut params = app.world_mut().resource_mut::<SimParams>();
+                let world = app.world_mut();
                 match player_action(&mut rng) {
                     Action::Resize(factor) => {
-                        params.arena_size = (scene_arena * factor).clamp(
+                        world.resource_mut::<SimParams>().arena_size = (scene_arena * factor).clamp(
                             DVec2::splat(*ARENA_SIDE_RANGE.start()),
                             DVec2::splat(*ARENA_SIDE_RANGE.end()),
                         )
                     }
                     Action::Minimise => {
-                        params.arena_size = DVec2::ZERO;
+                        world.resource_mut::<SimParams>().arena_size = DVec2::ZERO;
                         restore_at = Some(done + MINIMISED_STEPS);
                     }
-                    Action::Retune => retune(&mut params, &mut rng),
+                    Action::Retune => retune(world, &mut rng),
                 }
-                params.clamp_to_limits();
+                world.resource_mut::<SimParams>().clamp_to_limits();
+                world.resource_mut::<RunControl>().clamp_to_limits();
             }
             app.update();
             done += 1;
@@ -329,13 +330,19 @@ fn player_action(rng: &mut ChaCha8Rng) -> Action {
 }
 
 /// Moves one physics slider to a new value from its range (extremes often).
-fn retune(params: &mut SimParams, rng: &mut ChaCha8Rng) {
+fn retune(world: &mut World, rng: &mut ChaCha8Rng) {
     match rng.random_range(0..5) {
-        0 => params.restitution = extreme(rng, &RESTITUTION_RANGE, false),
-        1 => params.gravity.y = extreme(rng, &GRAVITY_SLIDER, false),
-        2 => params.time_scale = extreme(rng, &TIME_SCALE_SLIDER, false),
-        3 => params.linear_damping = extreme(rng, &DAMPING_SLIDER, false),
-        _ => params.collisions = CollisionMode::ALL[rng.random_range(0..2)],
+        0 => {
+            world.resource_mut::<SimParams>().restitution = extreme(rng, &RESTITUTION_RANGE, false)
+        }
+        1 => world.resource_mut::<SimParams>().gravity.y = extreme(rng, &GRAVITY_SLIDER, false),
+        2 => {
+            world.resource_mut::<RunControl>().time_scale = extreme(rng, &TIME_SCALE_SLIDER, false)
+        }
+        3 => {
+            world.resource_mut::<SimParams>().linear_damping = extreme(rng, &DAMPING_SLIDER, false)
+        }
+        _ => world.resource_mut::<Solver>().collisions = CollisionMode::ALL[rng.random_range(0..2)],
     }
 }
 

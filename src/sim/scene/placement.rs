@@ -5,18 +5,8 @@
 use bevy::math::DVec2;
 use rand::{Rng, RngExt};
 
-use super::collision::narrow_phase::Circle;
-
-/// Two balls overlap when they interpenetrate by more than this fraction of their radii sum,
-/// so hand-written decimals that touch (Newton's cradle) are accepted.
-const OVERLAP_TOLERANCE: f64 = 1e-9;
-
-/// Whether two circles overlap by more than rounding.
-pub fn overlapping(a: Circle, b: Circle) -> bool {
-    let reach = a.radius + b.radius;
-    let distance = a.center.distance(b.center);
-    reach - distance > OVERLAP_TOLERANCE * reach
-}
+use crate::sim::geometry::Circle;
+use crate::sim::geometry::circle::overlapping;
 
 /// An incremental grid of the balls placed so far: cells hold linked lists of ball indices.
 pub struct PlacementGrid {

@@ -1,0 +1,143 @@
+//! Predicted impacts: what the continuous mode's collision stage finds for each pair and
+//! each ball against the walls, ordered by time so the timeline can take the earliest first.
+
+use std::cmp::Ordering;
+
+use bevy::math::DVec2;
+
+use crate::sim::geometry::circle::{Circle, MIN_APPROACH_SPEED, time_of_impact};
+use crate::sim::geometry::wall::Wall;
+
+/// The smallest circle holding `circle` wherever it is while moving at `velocity` for
+/// `seconds`: centred halfway along the path.
+#[inline]
+pub fn swept_circle(circle: Circle, velocity: DVec2, seconds: f64) -> Circle {
+    Circle::new(
+        circle.center + velocity * (0.5 * seconds),
+        circle.radius + velocity.length() * (0.5 * seconds),
+    )
+}
+
+/// [`time_of_impact`] for pairs closing faster than [`MIN_APPROACH_SPEED`].
+#[inline]
+pub fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2) -> Option<f64> {
+    let offset = b.center - a.center;
+    let closing = (velocity_a - velocity_b).dot(offset);
+    if closing <= 0.0
+        || closing * closing <= MIN_APPROACH_SPEED * MIN_APPROACH_SPEED * offset.length_squared()
+    {
+        return None;
+    }
+    time_of_impact(a, velocity_a, b, velocity_b)
+}
+
+/// `other` values from here up name a wall, below it a ball.
+const WALL_BASE: u32 = u32::MAX - 3;
+
+/// A predicted impact: ball `a` with ball `other` (then `a < other`) or with a wall.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Impact {
+    /// Seconds into the step.
+    pub time: f64,
+    pub a: u32,
+    pub other: u32,
+    /// How many hits `a` and `other` had had when this was predicted.
+    pub hits_a: u32,
+    pub hits_other: u32,
+}
+
+impl Impact {
+    /// Ball `ball`, which has had `hits` hits, reaching `wall` at `time`.
+    pub fn with_wall(time: f64, ball: usize, hits: u32, wall: Wall) -> Self {
+        Self {
+            time,
+            a: ball as u32,
+            other: WALL_BASE + wall as u32,
+            hits_a: hits,
+            hits_other: 0,
+        }
+    }
+
+    /// Balls `i` and `j`, with `hits_i` and `hits_j` hits, meeting at `time`; stored with the
+    /// lower index first, so a pair has one key whichever ball it was found from.
+    pub fn between(time: f64, (i, hits_i): (usize, u32), (j, hits_j): (usize, u32)) -> Self {
+        let ((a, hits_a), (b, hits_other)) = if i < j {
+            ((i, hits_i), (j, hits_j))
+        } else {
+            ((j, hits_j), (i, hits_i))
+        };
+        Self {
+            time,
+            a: a as u32,
+            other: b as u32,
+            hits_a,
+            hits_other,
+        }
+    }
+
+    /// The wall this impact is with, if it is with a wall.
+    pub fn wall(&self) -> Option<Wall> {
+        (self.other >= WALL_BASE).then(|| Wall::ALL[(self.other - WALL_BASE) as usize])
+    }
+
+    fn key(&self) -> (u32, u32, u32, u32) {
+        (self.a, self.other, self.hits_a, self.hits_other)
+    }
+}
+
+impl Eq for Impact {}
+
+impl Ord for Impact {
+    /// Earliest first; equal times in a fixed order of the balls, so the result never depends
+    /// on the order in which the impacts were found.
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.time
+            .total_cmp(&other.time)
+            .then_with(|| self.key().cmp(&other.key()))
+    }
+}
+
+impl PartialOrd for Impact {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// What the collision stage's search finds for a pair.
+#[derive(Clone, Copy, Debug)]
+pub enum Prediction {
+    Impact(Impact),
+    /// Overlapping at the start of the step.
+    Overlap(u32, u32),
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+
+    use super::*;
+
+    #[test]
+    fn impacts_come_out_by_time_then_by_ball() {
+        let impact = |time, a, other| Impact {
+            time,
+            a,
+            other,
+            hits_a: 0,
+            hits_other: 0,
+        };
+        let mut queue: BinaryHeap<Reverse<Impact>> = [
+            impact(0.5, 3, 4),
+            impact(0.25, 7, 9),
+            impact(0.5, 1, 8),
+            impact(0.5, 1, 2),
+        ]
+        .into_iter()
+        .map(Reverse)
+        .collect();
+        let order: Vec<(u32, u32)> =
+            std::iter::from_fn(|| queue.pop().map(|Reverse(i)| (i.a, i.other))).collect();
+        assert_eq!(order, [(7, 9), (1, 2), (1, 8), (3, 4)]);
+    }
+}

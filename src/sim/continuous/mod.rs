@@ -1,0 +1,66 @@
+//! The continuous mode: each fixed step as a timeline of impacts, handled in time order, so
+//! nothing tunnels or overlaps and, with restitution 1, energy is kept to rounding.
+//!
+//! The movement stage only updates velocities (gravity, damping), so every ball's path over
+//! the step is a straight segment. Then:
+//!
+//! - stage 2, [`predict_impacts`] ([`predict`]): every approaching pair's and every ball's
+//!   wall time of impact within the step, found through the grid of swept circles
+//!   ([`impact`] holds what a prediction is);
+//! - stage 3, [`run_timeline`] ([`timeline`]): the impacts in time order, predicting anew for
+//!   the balls each one redirects ([`rerouted`] files those), then every ball to the end of
+//!   the step, and the balls written back.
+//!
+//! The [`Timeline`] works on plain arrays, so it is tested without an app.
+
+pub mod impact;
+pub mod predict;
+mod rerouted;
+pub mod timeline;
+
+use bevy::prelude::*;
+
+use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
+use crate::sim::clock::SimClock;
+use crate::sim::params::SimParams;
+use crate::sim::report::{ContactPoint, Hit, StepLog};
+pub use timeline::{StepSpec, Timeline};
+
+/// Stage 2: every impact of the coming step that the balls' paths lead to.
+pub fn predict_impacts(
+    clock: Res<SimClock>,
+    params: Res<SimParams>,
+    snapshot: Res<BallSnapshot>,
+    mut timeline: ResMut<Timeline>,
+) {
+    let spec = StepSpec::new(&params, clock.dt);
+    timeline.predict(&snapshot.circles, &snapshot.velocities, spec);
+}
+
+/// Stage 3: the impacts in time order; the balls written back at the end of the step.
+pub fn run_timeline(
+    clock: Res<SimClock>,
+    params: Res<SimParams>,
+    mut timeline: ResMut<Timeline>,
+    mut snapshot: ResMut<BallSnapshot>,
+    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut log: ResMut<StepLog>,
+) {
+    let spec = StepSpec::new(&params, clock.dt);
+    let BallSnapshot {
+        entities,
+        circles,
+        velocities,
+    } = &mut *snapshot;
+    let log = &mut *log;
+    timeline.run(circles, velocities, spec, |hit| {
+        if let Hit::Ball { point, normal, .. } = hit {
+            log.contacts.push(ContactPoint { point, normal });
+        }
+        log.hits.push(hit);
+    });
+    log.cut_short = timeline.cut_short;
+    write_back(entities, &mut balls, |index| {
+        Some((circles[index].center, velocities[index]))
+    });
+}

@@ -1,0 +1,381 @@
+//! Stage 3, continuous: the step as a timeline. Take the earliest predicted impact, move just
+//! its balls to that moment, exchange momentum along the line of centres (or bounce off the
+//! wall), predict anew for those balls, and repeat until the step is over; then move every
+//! ball to the end of the step.
+//!
+//! [`Timeline::run`] reads as those steps. Balls move lazily: each [`Mover`] remembers where it
+//! was at the moment of its last hit. An impact remembers how many hits each of its balls had
+//! when it was predicted; if either has been hit since, the prediction is stale and skipped.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::impact::{Impact, Prediction};
+use super::rerouted::Rerouted;
+use crate::sim::discrete::resolve::{ball_hit, resolve_overlaps};
+use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
+use crate::sim::geometry::grid::UniformGrid;
+use crate::sim::geometry::impulse::{normal_exchange, separate};
+use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_in_arena};
+use crate::sim::params::{BroadPhase, MassModel, SimParams};
+use crate::sim::report::Hit;
+
+/// A ball takes at most this many hits in one step. Only an inelastic collapse (a pile
+/// pressed together by gravity, restitution below 1) comes near it; the step then ends for
+/// that ball without further impacts, and the overlaps left at the end get the discrete
+/// mode's response. [`SimStats::cut_short_steps`](crate::sim::SimStats::cut_short_steps)
+/// counts such steps.
+pub const MAX_HITS_PER_BALL: u32 = 16;
+
+/// What a step's timeline needs of the simulation's parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSpec {
+    /// Seconds.
+    pub dt: f64,
+    /// Half the arena size, pixels.
+    pub half: DVec2,
+    pub restitution: f64,
+    pub mass_model: MassModel,
+}
+
+impl StepSpec {
+    pub fn new(params: &SimParams, dt: f64) -> Self {
+        Self {
+            dt,
+            half: params.half_extents(),
+            restitution: params.restitution,
+            mass_model: params.mass_model,
+        }
+    }
+}
+
+/// A ball on the step's timeline: where it is `clock` seconds into the step, and how many hits
+/// it has taken.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Mover {
+    pub center: DVec2,
+    pub velocity: DVec2,
+    pub radius: f64,
+    pub clock: f64,
+    pub hits: u32,
+}
+
+impl Mover {
+    pub fn circle(&self) -> Circle {
+        Circle::new(self.center, self.radius)
+    }
+
+    /// Where the ball is `time` seconds into the step.
+    #[inline]
+    pub fn center_at(&self, time: f64) -> DVec2 {
+        self.center + self.velocity * (time - self.clock)
+    }
+
+    pub fn advance(&mut self, time: f64) {
+        self.center = self.center_at(time);
+        self.clock = time;
+    }
+}
+
+/// The continuous mode's working state, kept between steps to reuse its buffers.
+#[derive(Resource, Debug, Default)]
+pub struct Timeline {
+    /// Each ball's circle swept over the whole step, sorted into cells.
+    pub(super) grid: UniformGrid,
+    pub(super) swept: Vec<Circle>,
+    /// Largest radius in `swept`.
+    pub(super) grid_reach: f64,
+    pub(super) predictions: Vec<Prediction>,
+    pub(super) queue: BinaryHeap<Reverse<Impact>>,
+    overlapping: Vec<(u32, u32)>,
+    /// Every ball on this step's timeline, by index: all a prediction reads of one ball in
+    /// one cache line.
+    pub(super) movers: Vec<Mover>,
+    pub(super) rerouted: Rerouted,
+    /// Contacts for the discrete response of a step cut short.
+    fallback: Vec<IndexedContact>,
+    /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
+    pub cut_short: bool,
+}
+
+impl Timeline {
+    /// The response stage's part: handles the predicted impacts in time order, predicting
+    /// anew for every ball hit, then moves every ball to the end of the step. `circles` and
+    /// `velocities` must be what [`predict`](Self::predict) was given; they are updated in
+    /// place. Calls `on_hit` for each hit, in the order handled.
+    pub fn run(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        spec: StepSpec,
+        mut on_hit: impl FnMut(Hit),
+    ) {
+        self.start(circles, velocities);
+        while let Some(Reverse(impact)) = self.queue.pop() {
+            if !self.is_current(&impact) {
+                continue;
+            }
+            match impact.wall() {
+                Some(wall) => self.bounce_off(impact, wall, spec, &mut on_hit),
+                None => self.collide(impact, spec, &mut on_hit),
+            }
+        }
+        self.move_to_the_end(circles, velocities, spec);
+        if self.cut_short {
+            self.resolve_what_was_cut_short(circles, velocities, spec, &mut on_hit);
+        }
+        self.push_apart_overlaps(circles, spec);
+        contain_at_the_end(circles, velocities, spec, &mut on_hit);
+    }
+
+    /// Every ball at the start of the step, no hits yet; the predictions queued.
+    fn start(&mut self, circles: &[Circle], velocities: &[DVec2]) {
+        self.movers.clear();
+        self.movers.extend(
+            circles
+                .iter()
+                .zip(velocities.iter())
+                .map(|(circle, velocity)| Mover {
+                    center: circle.center,
+                    velocity: *velocity,
+                    radius: circle.radius,
+                    clock: 0.0,
+                    hits: 0,
+                }),
+        );
+        self.rerouted.reset(self.grid.cell_count());
+        self.queue.clear();
+        self.overlapping.clear();
+        for prediction in &self.predictions {
+            match *prediction {
+                Prediction::Impact(impact) => self.queue.push(Reverse(impact)),
+                Prediction::Overlap(a, b) => self.overlapping.push((a, b)),
+            }
+        }
+        self.cut_short = false;
+    }
+
+    /// Whether `impact` still holds: neither ball has been hit since it was predicted, and
+    /// neither has used up its hits for the step (which cuts the step short).
+    fn is_current(&mut self, impact: &Impact) -> bool {
+        let hits_a = self.movers[impact.a as usize].hits;
+        let hits_other = match impact.wall() {
+            Some(_) => 0,
+            None => self.movers[impact.other as usize].hits,
+        };
+        if hits_a != impact.hits_a || hits_other != impact.hits_other {
+            return false; // stale: a ball in it has been hit since
+        }
+        if hits_a == MAX_HITS_PER_BALL || hits_other == MAX_HITS_PER_BALL {
+            self.cut_short = true;
+            return false;
+        }
+        true
+    }
+
+    /// Ball `impact.a` reaches `wall`: it bounces if it still moves into it.
+    fn bounce_off(
+        &mut self,
+        impact: Impact,
+        wall: Wall,
+        spec: StepSpec,
+        on_hit: &mut impl FnMut(Hit),
+    ) {
+        let (a, now) = (impact.a as usize, impact.time);
+        let mover = &mut self.movers[a];
+        mover.advance(now);
+        let mass = spec.mass_model.mass(mover.radius);
+        let Some(bounce) = bounce_off_wall(
+            mover.circle(),
+            &mut mover.velocity,
+            wall,
+            spec.half,
+            spec.restitution,
+            mass,
+        ) else {
+            return;
+        };
+        mover.center = bounce.center;
+        mover.hits += 1;
+        on_hit(Hit::Wall {
+            ball: impact.a,
+            wall,
+            time: now,
+            point: bounce.point,
+            impulse: bounce.impulse,
+            normal_speed: bounce.normal_speed,
+        });
+        self.predict_for(a, now, spec);
+    }
+
+    /// Balls `impact.a` and `impact.other` meet: they exchange momentum along the line of
+    /// centres if they still approach.
+    fn collide(&mut self, impact: Impact, spec: StepSpec, on_hit: &mut impl FnMut(Hit)) {
+        let (a, b, now) = (impact.a as usize, impact.other as usize, impact.time);
+        self.movers[a].advance(now);
+        self.movers[b].advance(now);
+        let (ma, mb) = (self.movers[a], self.movers[b]);
+        let offset = mb.center - ma.center;
+        let normal = contact_normal(offset, offset.length());
+        let Some(exchange) = normal_exchange(
+            ma.velocity,
+            mb.velocity,
+            spec.mass_model.inverse_mass(ma.radius),
+            spec.mass_model.inverse_mass(mb.radius),
+            normal,
+            spec.restitution,
+        ) else {
+            return;
+        };
+        self.movers[a].velocity = exchange.velocity_a;
+        self.movers[b].velocity = exchange.velocity_b;
+        self.movers[a].hits += 1;
+        self.movers[b].hits += 1;
+        on_hit(Hit::Ball {
+            a: impact.a,
+            b: impact.other,
+            time: now,
+            point: collision_point(ma.circle(), mb.circle()),
+            normal,
+            impulse: exchange.impulse,
+            closing_speed: exchange.closing_speed,
+        });
+        self.predict_for(a, now, spec);
+        self.predict_for(b, now, spec);
+    }
+
+    /// Every ball where the end of the step finds it.
+    fn move_to_the_end(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        spec: StepSpec,
+    ) {
+        for ((circle, velocity), mover) in circles
+            .iter_mut()
+            .zip(velocities.iter_mut())
+            .zip(&mut self.movers)
+        {
+            mover.advance(spec.dt);
+            (circle.center, *velocity) = (mover.center, mover.velocity);
+        }
+    }
+
+    /// Some balls stopped taking hits: whatever overlaps now gets the discrete response.
+    fn resolve_what_was_cut_short(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        spec: StepSpec,
+        on_hit: &mut impl FnMut(Hit),
+    ) {
+        self.fallback.clear();
+        find_contacts(
+            circles,
+            BroadPhase::Grid,
+            &mut self.grid,
+            &mut self.fallback,
+        );
+        let pairs = self.fallback.iter().map(|contact| (contact.a, contact.b));
+        resolve_overlaps(
+            pairs,
+            circles,
+            velocities,
+            spec.mass_model,
+            spec.restitution,
+            |a, b, geometry, exchange| on_hit(ball_hit(a, b, spec.dt, geometry, exchange)),
+        );
+    }
+
+    /// Pushes apart, shared by inverse mass, the pairs that overlapped at the start of the
+    /// step and still do.
+    fn push_apart_overlaps(&self, circles: &mut [Circle], spec: StepSpec) {
+        for &(a, b) in &self.overlapping {
+            let (a, b) = (a as usize, b as usize);
+            let Some(geometry) = circle_contact(circles[a], circles[b]) else {
+                continue;
+            };
+            let inverse_masses = (
+                spec.mass_model.inverse_mass(circles[a].radius),
+                spec.mass_model.inverse_mass(circles[b].radius),
+            );
+            separate(circles, (a, b), geometry, inverse_masses);
+        }
+    }
+}
+
+/// Rounding can leave a ball a hair past a wall, and pushing overlaps apart can push one into
+/// it: the same containment as the discrete mode puts it back.
+fn contain_at_the_end(
+    circles: &mut [Circle],
+    velocities: &mut [DVec2],
+    spec: StepSpec,
+    on_hit: &mut impl FnMut(Hit),
+) {
+    for (index, (circle, velocity)) in circles.iter_mut().zip(velocities.iter_mut()).enumerate() {
+        let contained = contain_in_arena(
+            circle.center,
+            *velocity,
+            circle.radius,
+            spec.half,
+            spec.restitution,
+        );
+        (circle.center, *velocity) = (contained.position, contained.velocity);
+        for hit in Hit::walls_of(
+            index as u32,
+            &contained,
+            spec.dt,
+            spec.half,
+            spec.restitution,
+            spec.mass_model.mass(circle.radius),
+        ) {
+            on_hit(hit);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_timeline_on_plain_arrays_bounces_a_fast_pair_and_keeps_energy() {
+        let spec = StepSpec {
+            dt: 1.0,
+            half: DVec2::new(1_000.0, 1_000.0),
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+        };
+        let mut circles = vec![
+            Circle::new(DVec2::new(-100.0, 0.0), 5.0),
+            Circle::new(DVec2::new(100.0, 3.0), 10.0),
+        ];
+        let mut velocities = vec![DVec2::new(300.0, 0.0), DVec2::new(-300.0, 0.0)];
+        let energy = |v: &[DVec2], c: &[Circle]| -> f64 {
+            v.iter()
+                .zip(c)
+                .map(|(v, c)| 0.5 * c.radius * v.length_squared())
+                .sum()
+        };
+        let before = energy(&velocities, &circles);
+        let mut timeline = Timeline::default();
+        timeline.predict(&circles, &velocities, spec);
+        let mut hits = Vec::new();
+        timeline.run(&mut circles, &mut velocities, spec, |hit| hits.push(hit));
+        assert_eq!(hits.len(), 1);
+        let Hit::Ball { time, point, .. } = hits[0] else {
+            panic!("a ball hit")
+        };
+        // Closing 600 px/s over 200 - sqrt(15^2 - 3^2) px.
+        let expected = (200.0 - (15.0f64 * 15.0 - 9.0).sqrt()) / 600.0;
+        assert!((time - expected).abs() < 1e-12, "{time} vs {expected}");
+        assert!(point.x.abs() < 15.0);
+        assert!((energy(&velocities, &circles) - before).abs() < 1e-9 * before);
+        assert!(circles[0].center.distance(circles[1].center) >= 15.0 - 1e-9);
+        assert!(velocities[0].x < 0.0 && velocities[1].x > 0.0);
+    }
+}

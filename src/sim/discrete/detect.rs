@@ -1,0 +1,45 @@
+//! Stage 2, discrete: find every touching pair among the moved balls and record it as a
+//! contact. The broad phase proposes candidate pairs; the AABB test and the exact
+//! squared-distance test keep the touching ones.
+//!
+//! Runs in [`SimSystems::Collision`](crate::sim::SimSystems::Collision) in discrete mode, on
+//! the contiguous [`BallSnapshot`] the movement stage wrote. Writes [`Contacts`] for the
+//! response and each contact point to the [`StepLog`]; changes no ball.
+
+use bevy::prelude::*;
+
+use crate::sim::ball::BallSnapshot;
+use crate::sim::geometry::grid::UniformGrid;
+use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::params::Solver;
+use crate::sim::report::{ContactPoint, StepLog};
+
+/// This step's touching pairs, by their places in the [`BallSnapshot`], in a stable order:
+/// the response handles them in this order.
+#[derive(Resource, Debug, Default)]
+pub struct Contacts(pub Vec<IndexedContact>);
+
+/// The grid, kept between steps to reuse its buffers.
+#[derive(Resource, Default)]
+pub struct DetectionGrid(UniformGrid);
+
+pub fn detect_contacts(
+    solver: Res<Solver>,
+    snapshot: Res<BallSnapshot>,
+    mut grid: ResMut<DetectionGrid>,
+    mut contacts: ResMut<Contacts>,
+    mut log: ResMut<StepLog>,
+) {
+    contacts.0.clear();
+    find_contacts(
+        &snapshot.circles,
+        solver.broad_phase,
+        &mut grid.0,
+        &mut contacts.0,
+    );
+    log.contacts
+        .extend(contacts.0.iter().map(|contact| ContactPoint {
+            point: contact.geometry.point,
+            normal: contact.geometry.normal,
+        }));
+}

@@ -1,0 +1,140 @@
+//! Stage 3, discrete: for each contact, the elastic exchange along the line of centres, then
+//! separation so nothing sticks; finally the walls again for the separated balls, since
+//! separation may push a ball into a wall.
+//!
+//! Runs in [`SimSystems::Response`](crate::sim::SimSystems::Response) in discrete mode,
+//! reading [`Contacts`] in their stable order (Gauss–Seidel: each contact sees the velocities
+//! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then writes the
+//! balls that changed back to their components in one pass. Records each exchange and wall
+//! hit in the [`StepLog`].
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::detect::Contacts;
+use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
+use crate::sim::clock::SimClock;
+use crate::sim::geometry::circle::{Circle, ContactGeometry, circle_contact};
+use crate::sim::geometry::impulse::{Exchange, normal_exchange, separate};
+use crate::sim::geometry::wall::contain_in_arena;
+use crate::sim::params::{MassModel, SimParams};
+use crate::sim::report::{Hit, StepLog};
+
+/// The discrete response on plain arrays: for each pair `(a, b)` of indices, in order, that
+/// still touches where the earlier pairs left it, the exchange along the normal (if the balls
+/// approach; `on_exchange` hears of it) and then separation shared by inverse mass. Both
+/// collision modes use it: discrete for every contact, continuous for a step it cut short.
+pub fn resolve_overlaps(
+    pairs: impl IntoIterator<Item = (u32, u32)>,
+    circles: &mut [Circle],
+    velocities: &mut [DVec2],
+    mass_model: MassModel,
+    restitution: f64,
+    mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
+) {
+    for (a, b) in pairs {
+        let (ia, ib) = (a as usize, b as usize);
+        // Earlier pairs may have moved either ball: work from where they are now.
+        let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
+            continue;
+        };
+        let inverse_mass_a = mass_model.inverse_mass(circles[ia].radius);
+        let inverse_mass_b = mass_model.inverse_mass(circles[ib].radius);
+        if let Some(exchange) = normal_exchange(
+            velocities[ia],
+            velocities[ib],
+            inverse_mass_a,
+            inverse_mass_b,
+            geometry.normal,
+            restitution,
+        ) {
+            velocities[ia] = exchange.velocity_a;
+            velocities[ib] = exchange.velocity_b;
+            on_exchange(a, b, geometry, exchange);
+        }
+        separate(
+            circles,
+            (ia, ib),
+            geometry,
+            (inverse_mass_a, inverse_mass_b),
+        );
+    }
+}
+
+/// The hit an exchange at `time` into the step records.
+pub fn ball_hit(a: u32, b: u32, time: f64, geometry: ContactGeometry, exchange: Exchange) -> Hit {
+    Hit::Ball {
+        a,
+        b,
+        time,
+        point: geometry.point,
+        normal: geometry.normal,
+        impulse: exchange.impulse,
+        closing_speed: exchange.closing_speed,
+    }
+}
+
+pub fn resolve_contacts(
+    clock: Res<SimClock>,
+    contacts: Res<Contacts>,
+    params: Res<SimParams>,
+    mut snapshot: ResMut<BallSnapshot>,
+    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut log: ResMut<StepLog>,
+    mut in_contact: Local<Vec<bool>>,
+) {
+    if contacts.0.is_empty() {
+        return;
+    }
+    // Discrete mode sees a hit only at the end of the step, as an overlap.
+    let step_end = clock.dt;
+    let BallSnapshot {
+        entities,
+        circles,
+        velocities,
+    } = &mut *snapshot;
+    in_contact.clear();
+    in_contact.resize(entities.len(), false);
+    for contact in &contacts.0 {
+        (
+            in_contact[contact.a as usize],
+            in_contact[contact.b as usize],
+        ) = (true, true);
+    }
+    let pairs = contacts.0.iter().map(|contact| (contact.a, contact.b));
+    let (mass_model, restitution) = (params.mass_model, params.restitution);
+    resolve_overlaps(
+        pairs,
+        circles,
+        velocities,
+        mass_model,
+        restitution,
+        |a, b, geometry, exchange| log.hits.push(ball_hit(a, b, step_end, geometry, exchange)),
+    );
+    // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
+    // the movement stage kept every ball inside, so only they need the walls again, and only
+    // they are written back.
+    let half = params.half_extents();
+    let mut settle = |index: usize| {
+        let circle = circles[index];
+        let contained = contain_in_arena(
+            circle.center,
+            velocities[index],
+            circle.radius,
+            half,
+            restitution,
+        );
+        log.hits.extend(Hit::walls_of(
+            index as u32,
+            &contained,
+            step_end,
+            half,
+            restitution,
+            mass_model.mass(circle.radius),
+        ));
+        (contained.position, contained.velocity)
+    };
+    write_back(entities, &mut balls, |index| {
+        in_contact[index].then(|| settle(index))
+    });
+}

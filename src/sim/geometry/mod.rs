@@ -1,0 +1,13 @@
+//! Pure geometry and mechanics, apart from any system: circles ([`circle`]), the arena's walls
+//! ([`wall`]), impulses ([`impulse`]), the uniform grid ([`grid`]) and the touching pairs it
+//! finds ([`pairs`]). Plain functions over plain values, each with its unit tests; every stage,
+//! the aiming guide, scene placement and the measurements are built from them.
+
+pub mod circle;
+pub mod grid;
+pub mod impulse;
+pub mod pairs;
+pub mod wall;
+
+pub use circle::{Circle, ContactGeometry};
+pub use wall::Wall;

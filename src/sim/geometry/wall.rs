@@ -1,0 +1,328 @@
+//! The arena's walls: which wall a ball meets and when, how it bounces, and how a ball that
+//! crossed one is put back. Pure functions over plain values.
+//!
+//! The discrete mode contains every ball after moving it ([`contain_in_arena`]); the
+//! continuous mode finds each ball's exact moment at a wall ([`wall_time_of_impact`]) and
+//! bounces it there ([`bounce_off_wall`]), then contains at the end of the step against
+//! rounding; the aiming guide uses the same time of impact.
+
+use bevy::math::DVec2;
+
+use super::circle::{Circle, MIN_APPROACH_SPEED};
+use super::impulse::wall_impulse;
+
+/// The four sides of the arena.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Wall {
+    Left,
+    Right,
+    Bottom,
+    Top,
+}
+
+impl Wall {
+    pub const ALL: [Wall; 4] = [Wall::Left, Wall::Right, Wall::Bottom, Wall::Top];
+
+    /// The wall's outward normal (pointing out of the arena).
+    pub fn outward_normal(self) -> DVec2 {
+        match self {
+            Wall::Left => DVec2::NEG_X,
+            Wall::Right => DVec2::X,
+            Wall::Bottom => DVec2::NEG_Y,
+            Wall::Top => DVec2::Y,
+        }
+    }
+}
+
+/// A wall hit found by [`contain_in_arena`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallHit {
+    pub wall: Wall,
+    /// Speed into the wall before the hit, pixels per second (positive).
+    pub normal_speed: f64,
+}
+
+/// The outcome of [`contain_in_arena`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contained {
+    pub position: DVec2,
+    pub velocity: DVec2,
+    /// At most one hit per axis (a corner gives two).
+    pub hits: [Option<WallHit>; 2],
+}
+
+/// Puts a ball whose circle crosses a wall of the arena `[-half, half]` back inside.
+///
+/// A ball moving into the wall is mirrored back by the restitution-scaled overshoot and its
+/// normal velocity reflected and scaled by `restitution`; one already moving away (pushed out
+/// by a neighbour) is only moved back to the wall. A ball wider than the arena is centred on
+/// that axis and stopped along it.
+pub fn contain_in_arena(
+    mut position: DVec2,
+    mut velocity: DVec2,
+    radius: f64,
+    half: DVec2,
+    restitution: f64,
+) -> Contained {
+    let mut hits = [None, None];
+    for (axis, (low_wall, high_wall)) in [(Wall::Left, Wall::Right), (Wall::Bottom, Wall::Top)]
+        .into_iter()
+        .enumerate()
+    {
+        let limit = half[axis] - radius;
+        if limit <= 0.0 {
+            position[axis] = 0.0;
+            velocity[axis] = 0.0;
+            continue;
+        }
+        for (side, wall) in [(1.0, high_wall), (-1.0, low_wall)] {
+            let overshoot = side * position[axis] - limit;
+            if overshoot <= 0.0 {
+                continue;
+            }
+            let speed_into_wall = side * velocity[axis];
+            if speed_into_wall > 0.0 {
+                position[axis] = side * (limit - restitution * overshoot);
+                velocity[axis] = -side * restitution * speed_into_wall;
+                hits[axis] = Some(WallHit {
+                    wall,
+                    normal_speed: speed_into_wall,
+                });
+            }
+            position[axis] = position[axis].clamp(-limit, limit);
+        }
+    }
+    Contained {
+        position,
+        velocity,
+        hits,
+    }
+}
+
+/// Where a ball at `position` touches `wall` of the arena `[-half, half]`.
+pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
+    match wall {
+        Wall::Left => DVec2::new(-half.x, position.y),
+        Wall::Right => DVec2::new(half.x, position.y),
+        Wall::Bottom => DVec2::new(position.x, -half.y),
+        Wall::Top => DVec2::new(position.x, half.y),
+    }
+}
+
+/// Seconds until a ball at `position` moving at `velocity` touches a wall of the arena
+/// `[-half, half]`, and which wall: zero if it already touches (or crosses) a wall it moves
+/// into. `None` if it moves into no wall (slower than [`MIN_APPROACH_SPEED`] counts as not
+/// moving), or only along axes where it is wider than the arena (containment centres those).
+pub fn wall_time_of_impact(
+    position: DVec2,
+    velocity: DVec2,
+    radius: f64,
+    half: DVec2,
+) -> Option<(f64, Wall)> {
+    let mut first: Option<(f64, Wall)> = None;
+    for (axis, low_wall, high_wall) in [(0, Wall::Left, Wall::Right), (1, Wall::Bottom, Wall::Top)]
+    {
+        let limit = half[axis] - radius;
+        let speed = velocity[axis];
+        if limit <= 0.0 || speed.abs() <= MIN_APPROACH_SPEED {
+            continue;
+        }
+        let (gap, wall) = if speed > 0.0 {
+            (limit - position[axis], high_wall)
+        } else {
+            (limit + position[axis], low_wall)
+        };
+        let time = (gap / speed.abs()).max(0.0);
+        if first.is_none_or(|(earliest, _)| time < earliest) {
+            first = Some((time, wall));
+        }
+    }
+    first
+}
+
+/// A ball's bounce off a wall: [`bounce_off_wall`]'s result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallBounce {
+    /// The centre, set exactly against the wall.
+    pub center: DVec2,
+    pub point: DVec2,
+    /// Magnitude of the wall's impulse, mass x pixels per second.
+    pub impulse: f64,
+    /// Speed into the wall before the bounce, pixels per second.
+    pub normal_speed: f64,
+}
+
+/// Reflects a ball of `mass` that touches `wall` of the arena `[-half, half]` and moves into
+/// it: the normal velocity is reversed and scaled by `restitution`. `None` (and no change) if
+/// it moves away from the wall.
+pub fn bounce_off_wall(
+    circle: Circle,
+    velocity: &mut DVec2,
+    wall: Wall,
+    half: DVec2,
+    restitution: f64,
+    mass: f64,
+) -> Option<WallBounce> {
+    let outward = wall.outward_normal();
+    let normal_speed = velocity.dot(outward);
+    if normal_speed <= 0.0 {
+        return None;
+    }
+    *velocity -= outward * ((1.0 + restitution) * normal_speed);
+    let axis = usize::from(outward.y != 0.0);
+    let mut center = circle.center;
+    center[axis] = outward[axis] * (half[axis] - circle.radius);
+    Some(WallBounce {
+        center,
+        point: wall_contact_point(wall, center, half),
+        impulse: wall_impulse(mass, restitution, normal_speed),
+        normal_speed,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HALF: DVec2 = DVec2::new(100.0, 50.0);
+
+    #[test]
+    fn ball_past_the_right_wall_is_mirrored_back_and_reflected() {
+        let c = contain_in_arena(
+            DVec2::new(95.0, 0.0),
+            DVec2::new(30.0, 7.0),
+            10.0,
+            HALF,
+            1.0,
+        );
+        assert_eq!(c.position, DVec2::new(85.0, 0.0));
+        assert_eq!(c.velocity, DVec2::new(-30.0, 7.0));
+        assert_eq!(
+            c.hits,
+            [
+                Some(WallHit {
+                    wall: Wall::Right,
+                    normal_speed: 30.0
+                }),
+                None
+            ]
+        );
+    }
+
+    #[test]
+    fn restitution_scales_the_normal_velocity_only() {
+        let c = contain_in_arena(
+            DVec2::new(0.0, -45.0),
+            DVec2::new(3.0, -20.0),
+            10.0,
+            HALF,
+            0.5,
+        );
+        assert_eq!(c.velocity, DVec2::new(3.0, 10.0));
+        assert_eq!(c.position, DVec2::new(0.0, -37.5));
+        assert_eq!(c.hits[1].unwrap().wall, Wall::Bottom);
+    }
+
+    #[test]
+    fn a_corner_gives_two_hits() {
+        let c = contain_in_arena(
+            DVec2::new(-99.0, 49.0),
+            DVec2::new(-1.0, 1.0),
+            2.0,
+            HALF,
+            1.0,
+        );
+        assert_eq!(c.hits[0].unwrap().wall, Wall::Left);
+        assert_eq!(c.hits[1].unwrap().wall, Wall::Top);
+        assert_eq!(c.velocity, DVec2::new(1.0, -1.0));
+    }
+
+    #[test]
+    fn ball_moving_away_is_only_put_back() {
+        let c = contain_in_arena(
+            DVec2::new(93.0, 0.0),
+            DVec2::new(-5.0, 0.0),
+            10.0,
+            HALF,
+            1.0,
+        );
+        assert_eq!(c.position, DVec2::new(90.0, 0.0));
+        assert_eq!(c.velocity, DVec2::new(-5.0, 0.0));
+        assert_eq!(c.hits, [None, None]);
+    }
+
+    #[test]
+    fn huge_overshoot_still_ends_inside() {
+        let c = contain_in_arena(
+            DVec2::new(5000.0, 0.0),
+            DVec2::new(1e5, 0.0),
+            10.0,
+            HALF,
+            1.0,
+        );
+        assert!(c.position.x.abs() <= 90.0);
+    }
+
+    #[test]
+    fn ball_wider_than_the_arena_is_centred_without_nan() {
+        let c = contain_in_arena(DVec2::new(3.0, 3.0), DVec2::new(5.0, 5.0), 60.0, HALF, 1.0);
+        assert_eq!(c.position.y, 0.0);
+        assert_eq!(c.velocity.y, 0.0);
+        assert!(c.position.is_finite() && c.velocity.is_finite());
+        let c = contain_in_arena(
+            DVec2::new(3.0, 3.0),
+            DVec2::new(5.0, 5.0),
+            1.0,
+            DVec2::ZERO,
+            1.0,
+        );
+        assert_eq!((c.position, c.velocity), (DVec2::ZERO, DVec2::ZERO));
+    }
+
+    #[test]
+    fn wall_time_is_the_gap_over_the_speed_toward_the_nearer_wall() {
+        // 90 px to the right wall's limit at 30 px/s; 40 px to the top at 10 px/s.
+        let (time, wall) =
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(30.0, 10.0), 10.0, HALF).unwrap();
+        assert_eq!((time, wall), (3.0, Wall::Right));
+        let (time, wall) =
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(-1.0, -20.0), 10.0, HALF).unwrap();
+        assert_eq!((time, wall), (2.0, Wall::Bottom));
+        // Already through a wall and still moving into it: now. Moving away: never.
+        let past = DVec2::new(95.0, 0.0);
+        assert_eq!(
+            wall_time_of_impact(past, DVec2::X, 10.0, HALF),
+            Some((0.0, Wall::Right))
+        );
+        assert_eq!(
+            wall_time_of_impact(past, DVec2::NEG_X, 10.0, HALF).map(|h| h.1),
+            Some(Wall::Left)
+        );
+        assert_eq!(
+            wall_time_of_impact(DVec2::ZERO, DVec2::ZERO, 10.0, HALF),
+            None
+        );
+        // Wider than the arena along y: only x counts.
+        assert_eq!(
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(0.0, 5.0), 60.0, HALF),
+            None
+        );
+    }
+
+    #[test]
+    fn a_bounce_reflects_the_normal_speed_and_sets_the_ball_against_the_wall() {
+        let mut velocity = DVec2::new(20.0, -5.0);
+        let circle = Circle::new(DVec2::new(89.5, 3.0), 10.0);
+        let bounce = bounce_off_wall(circle, &mut velocity, Wall::Right, HALF, 0.5, 2.0).unwrap();
+        assert_eq!(velocity, DVec2::new(-10.0, -5.0));
+        assert_eq!(bounce.center, DVec2::new(90.0, 3.0));
+        assert_eq!(bounce.point, DVec2::new(100.0, 3.0));
+        assert_eq!((bounce.impulse, bounce.normal_speed), (60.0, 20.0));
+        let mut away = DVec2::new(-1.0, 0.0);
+        assert_eq!(
+            bounce_off_wall(circle, &mut away, Wall::Right, HALF, 0.5, 2.0),
+            None
+        );
+        assert_eq!(away, DVec2::new(-1.0, 0.0));
+    }
+}

@@ -1,0 +1,166 @@
+//! Stage 4, report: what the earlier stages recorded in the [`StepLog`] becomes the outward
+//! [`BallCollision`] and [`WallCollision`] messages, the [`SimStats`] counters and the
+//! overlay's [`ContactPoints`]. The stages themselves write no messages and no counters.
+//!
+//! Runs in [`SimSystems::Report`](super::SimSystems::Report), after the response. In debug
+//! builds the same stage asserts that every position and velocity is finite.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::ball::{Ball, BallSnapshot, Position, Velocity};
+use super::clock::SimClock;
+use super::geometry::impulse::wall_impulse;
+use super::geometry::wall::{Contained, Wall, wall_contact_point};
+use super::measure::SimStats;
+use super::messages::{BallCollision, WallCollision};
+
+/// A hit a stage handled. Times are seconds into the step; indices are places in this step's
+/// [`BallSnapshot`] (or in the arrays given to the continuous timeline).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Hit {
+    Ball {
+        a: u32,
+        b: u32,
+        time: f64,
+        /// The radius-weighted point, which for touching balls is where they touch.
+        point: DVec2,
+        /// Unit vector from `a` towards `b`.
+        normal: DVec2,
+        impulse: f64,
+        closing_speed: f64,
+    },
+    Wall {
+        ball: u32,
+        wall: Wall,
+        time: f64,
+        point: DVec2,
+        impulse: f64,
+        normal_speed: f64,
+    },
+}
+
+impl Hit {
+    /// The wall hits of a containment of ball `ball` (of `mass`) at `time` into the step, in
+    /// the arena `[-half, half]`.
+    pub fn walls_of(
+        ball: u32,
+        contained: &Contained,
+        time: f64,
+        half: DVec2,
+        restitution: f64,
+        mass: f64,
+    ) -> impl Iterator<Item = Hit> {
+        let position = contained.position;
+        contained
+            .hits
+            .into_iter()
+            .flatten()
+            .map(move |hit| Hit::Wall {
+                ball,
+                wall: hit.wall,
+                time,
+                point: wall_contact_point(hit.wall, position, half),
+                impulse: wall_impulse(mass, restitution, hit.normal_speed),
+                normal_speed: hit.normal_speed,
+            })
+    }
+}
+
+/// A point where two balls touched this step, and the normal there: what the overlay draws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint {
+    pub point: DVec2,
+    /// Unit vector from the first ball towards the second.
+    pub normal: DVec2,
+}
+
+/// What happened in this step, recorded by the stages in the order it happened and emptied
+/// by the report stage.
+#[derive(Resource, Debug, Default)]
+pub struct StepLog {
+    pub hits: Vec<Hit>,
+    /// Discrete mode: every touching pair found; continuous mode: every ball–ball impact.
+    pub contacts: Vec<ContactPoint>,
+    /// A continuous step stopped handling impacts for some ball (see
+    /// [`MAX_HITS_PER_BALL`](super::continuous::timeline::MAX_HITS_PER_BALL)).
+    pub cut_short: bool,
+}
+
+/// The last step's contact points, for the overlay and the bench.
+#[derive(Resource, Debug, Default)]
+pub struct ContactPoints(pub Vec<ContactPoint>);
+
+/// Turns the step's log into messages, counters and contact points.
+pub(super) fn report_step(
+    clock: Res<SimClock>,
+    snapshot: Res<BallSnapshot>,
+    mut log: ResMut<StepLog>,
+    mut stats: ResMut<SimStats>,
+    mut contact_points: ResMut<ContactPoints>,
+    mut ball_hits: MessageWriter<BallCollision>,
+    mut wall_hits: MessageWriter<WallCollision>,
+) {
+    let step_start = clock.elapsed;
+    let entities = &snapshot.entities;
+    for hit in log.hits.drain(..) {
+        match hit {
+            Hit::Ball {
+                a,
+                b,
+                time,
+                point,
+                normal,
+                impulse,
+                closing_speed,
+            } => {
+                stats.ball_collisions += 1;
+                ball_hits.write(BallCollision {
+                    a: entities[a as usize],
+                    b: entities[b as usize],
+                    time: step_start + time,
+                    point,
+                    normal,
+                    impulse,
+                    normal_speed: closing_speed,
+                });
+            }
+            Hit::Wall {
+                ball,
+                wall,
+                time,
+                point,
+                impulse,
+                normal_speed,
+            } => {
+                stats.wall_collisions += 1;
+                stats.wall_impulse += impulse;
+                wall_hits.write(WallCollision {
+                    ball: entities[ball as usize],
+                    wall,
+                    time: step_start + time,
+                    point,
+                    impulse,
+                    normal_speed,
+                });
+            }
+        }
+    }
+    if std::mem::take(&mut log.cut_short) {
+        stats.cut_short_steps += 1;
+    }
+    contact_points.0.clear();
+    contact_points.0.append(&mut log.contacts);
+}
+
+#[cfg(debug_assertions)]
+pub(super) fn assert_state_is_finite(balls: Query<(&Position, &Velocity), With<Ball>>) {
+    for (position, velocity) in &balls {
+        assert!(
+            position.is_finite() && velocity.is_finite(),
+            "non-finite ball state: position {:?}, velocity {:?}",
+            position.0,
+            velocity.0
+        );
+    }
+}
