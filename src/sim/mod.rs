@@ -24,6 +24,13 @@
 //! **Where things live**: [`geometry`] the pure maths (circles, walls, impulses, the grid);
 //! [`discrete`] and [`continuous`] one folder per mode; [`measure`] what reads the state
 //! without changing it; [`scene`] scene files; [`params`] the parameters by owner.
+//!
+//! **Where gravity's work goes** (piles that rest and sleep): exact ballistic flight is pure
+//! maths beside the straight path it replaces (a `geometry/flight.rs` used by
+//! [`movement`] and the timeline's `Mover`); a contact solver both modes share is its own
+//! folder and stage (`sim/resting/`, a `SimSystems::Resting` set between `Response` and
+//! `Report`, reading the contacts the modes record); sleeping is a filter on what the
+//! movement stage puts into the snapshot, so sleeping balls cost nothing in any stage.
 
 pub mod aim;
 pub mod ball;

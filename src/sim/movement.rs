@@ -79,6 +79,7 @@ pub fn move_and_contain(
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
     let half = params.half_extents();
+    let (snapshot, log) = (&mut *snapshot, &mut *log);
     snapshot.clear();
     for (ball, mut position, mut previous, mut velocity, radius) in &mut balls {
         previous.0 = position.0;
@@ -108,6 +109,7 @@ pub fn integrate_velocities(
     mut snapshot: ResMut<BallSnapshot>,
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
+    let snapshot = &mut *snapshot;
     snapshot.clear();
     for (ball, position, mut previous, mut velocity, radius) in &mut balls {
         previous.0 = position.0;

@@ -8,7 +8,9 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{Ball, BallSnapshot, Position, Velocity};
+use super::ball::BallSnapshot;
+#[cfg(debug_assertions)]
+use super::ball::{Ball, Position, Velocity};
 use super::clock::SimClock;
 use super::geometry::impulse::wall_impulse;
 use super::geometry::wall::{Contained, Wall, wall_contact_point};
@@ -149,8 +151,9 @@ pub(super) fn report_step(
     if std::mem::take(&mut log.cut_short) {
         stats.cut_short_steps += 1;
     }
-    contact_points.0.clear();
-    contact_points.0.append(&mut log.contacts);
+    // Hand the buffer over rather than copy it; the log gets the old one back, emptied.
+    std::mem::swap(&mut contact_points.0, &mut log.contacts);
+    log.contacts.clear();
 }
 
 #[cfg(debug_assertions)]

@@ -103,13 +103,14 @@ pub fn resolve_contacts(
     }
     let pairs = contacts.0.iter().map(|contact| (contact.a, contact.b));
     let (mass_model, restitution) = (params.mass_model, params.restitution);
+    let hits = &mut log.hits;
     resolve_overlaps(
         pairs,
         circles,
         velocities,
         mass_model,
         restitution,
-        |a, b, geometry, exchange| log.hits.push(ball_hit(a, b, step_end, geometry, exchange)),
+        |a, b, geometry, exchange| hits.push(ball_hit(a, b, step_end, geometry, exchange)),
     );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
     // the movement stage kept every ball inside, so only they need the walls again, and only
@@ -124,14 +125,16 @@ pub fn resolve_contacts(
             half,
             restitution,
         );
-        log.hits.extend(Hit::walls_of(
-            index as u32,
-            &contained,
-            step_end,
-            half,
-            restitution,
-            mass_model.mass(circle.radius),
-        ));
+        if contained.hits != [None, None] {
+            hits.extend(Hit::walls_of(
+                index as u32,
+                &contained,
+                step_end,
+                half,
+                restitution,
+                mass_model.mass(circle.radius),
+            ));
+        }
         (contained.position, contained.velocity)
     };
     write_back(entities, &mut balls, |index| {
