@@ -1,6 +1,7 @@
 //! What the toy's controls do to the simulation, headless: single steps while paused, the
 //! intents the UI sends (fling, spawn, ball count), the ball-count slider, and the aiming
-//! guide's prediction against the simulation's outcome.
+//! guide's prediction against the simulation's outcome; pausing and a window with no room.
+//! Each runs in both collision modes where the mode could matter.
 
 use ballpit::prelude::*;
 use ballpit::sim::aim::{AimTarget, predict_first_hit};
