@@ -9,10 +9,10 @@
 //! - [`cli`]: the `ballpit` command line.
 //!
 //! The toy (the default `gui` feature: window, rendering, egui):
-//! - [`app`]: the toy's shared state (scene requests, view settings);
-//! - [`render`]: drawing the simulation (reads its state only);
-//! - [`ui`]: the egui panel, mouse and keys (send intents);
-//! - [`play`]: the windowed toy put together; [`diagnostics`]: its frame timings.
+//! - `app`: the toy's shared state (scene requests, view settings);
+//! - `render`: drawing the simulation (reads its state only);
+//! - `ui`: the egui panel, mouse and keys (send intents);
+//! - `play`: the windowed toy put together; `diagnostics`: its frame timings.
 
 pub mod cli;
 pub mod commands;

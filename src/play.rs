@@ -1,5 +1,5 @@
 //! The windowed toy put together: default plugins, the simulation, the toy's shared state
-//! ([`app`](crate::app)), its rendering, its UI and frame diagnostics; optionally a
+//! ([`app`]), its rendering, its UI and frame diagnostics; optionally a
 //! screenshot after a number of frames (for the README and for checks under Xvfb).
 
 use std::path::PathBuf;

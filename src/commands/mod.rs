@@ -1,4 +1,4 @@
-//! The headless commands, with no window or GPU: [`run`] steps a scene and reports, [`bench`]
+//! The headless commands, with no window or GPU: [`run`] steps a scene and reports, [`bench`](mod@bench)
 //! times the standard gas at several sizes, [`soak`] runs random scenes long with checks after
 //! every step. They build on [`headless`](crate::headless) apps and never touch the toy.
 

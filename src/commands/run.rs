@@ -1,4 +1,4 @@
-//! `ballpit run`: a scene stepped a fixed number of times in a [`headless_app`], measured
+//! `ballpit run`: a scene stepped a fixed number of times in a [`headless_app`](crate::headless::headless_app), measured
 //! into a [`RunReport`]; optionally every ball's final state in a [`StateDump`]. Used by the
 //! command line and the tests.
 

@@ -94,7 +94,7 @@ pub struct StepLog {
 pub struct ContactPoints(pub Vec<ContactPoint>);
 
 /// Turns the step's log into messages, counters and contact points.
-pub(super) fn report_step(
+pub fn report_step(
     clock: Res<SimClock>,
     snapshot: Res<BallSnapshot>,
     mut log: ResMut<StepLog>,

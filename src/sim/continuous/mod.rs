@@ -8,7 +8,7 @@
 //!   wall time of impact within the step, found through the grid of swept circles
 //!   ([`impact`] holds what a prediction is);
 //! - stage 3, [`run_timeline`] ([`timeline`]): the impacts in time order, predicting anew for
-//!   the balls each one redirects ([`rerouted`] files those), then every ball to the end of
+//!   the balls each one redirects (`rerouted.rs` files those), then every ball to the end of
 //!   the step, and the balls written back.
 //!
 //! The [`Timeline`] works on plain arrays, so it is tested without an app.

@@ -3,7 +3,7 @@
 //! wall), predict anew for those balls, and repeat until the step is over; then move every
 //! ball to the end of the step.
 //!
-//! [`Timeline::run`] reads as those steps. Balls move lazily: each [`Mover`] remembers where it
+//! [`Timeline::run`] reads as those steps. Balls move lazily: each `Mover` remembers where it
 //! was at the moment of its last hit. An impact remembers how many hits each of its balls had
 //! when it was predicted; if either has been hit since, the prediction is stale and skipped.
 
