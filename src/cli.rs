@@ -240,11 +240,15 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
     }
 }
 
+/// What a build without the `gui` feature says when asked to play.
+#[cfg(any(test, not(feature = "gui")))]
+const NO_WINDOW: &str = "this ballpit was built without the `gui` feature, so it cannot open a \
+     window; `ballpit run`, `bench` and `soak` work headless";
+
 /// A build without the `gui` feature has no window to play in.
 #[cfg(not(feature = "gui"))]
 fn run_window(_args: PlayArgs) -> Result<(), Box<dyn Error>> {
-    Err("this ballpit was built without the `gui` feature, so it cannot open a window;          `ballpit run`, `bench` and `soak` work headless"
-        .into())
+    Err(NO_WINDOW.into())
 }
 
 fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
@@ -331,4 +335,15 @@ fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
         serde_json::to_string(&run_case(case, args.threads as usize)?)?
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_headless_build_says_plainly_why_it_cannot_play() {
+        assert!(NO_WINDOW.contains("without the `gui` feature, so it cannot open a window;"));
+        assert!(!NO_WINDOW.contains("  "), "{NO_WINDOW}");
+    }
 }

@@ -14,12 +14,13 @@
 //! | [`SimSystems::Collision`] | [`detect_contacts`](discrete::detect::detect_contacts): grid, AABB, distance → [`Contacts`](discrete::detect::Contacts) | [`predict_impacts`](continuous::predict_impacts): every time of impact within the step |
 //! | [`SimSystems::Response`] | [`resolve_contacts`](discrete::resolve::resolve_contacts): exchange, separation, walls | [`run_timeline`](continuous::run_timeline): the impacts in time order |
 //! | [`SimSystems::Report`] | [`report_step`](report::report_step): messages, counters, contact points | the same |
+//! | around the stages | the clock's `start_step` before, `take_pending_step` and `end_step` in `Report`; a finiteness assertion in debug builds | the same |
 //!
 //! **Data flows one way**: components → [`BallSnapshot`](ball::BallSnapshot) (movement) →
 //! contacts or predicted impacts (collision) → components (response), each stage recording
 //! what happened in the [`StepLog`](report::StepLog); the report stage turns that into the
 //! outward [`BallCollision`] / [`WallCollision`] messages and the [`SimStats`] counters. Every
-//! stage reads the step's `dt` from the [`SimClock`].
+//! stage that needs the step's `dt` or the simulated time reads it from the [`SimClock`].
 //!
 //! **Where things live**: [`geometry`] the pure maths (circles, walls, impulses, the grid);
 //! [`discrete`] and [`continuous`] one folder per mode; [`measure`] what reads the state

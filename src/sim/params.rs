@@ -51,6 +51,9 @@ pub const TIME_SCALE_SLIDER: RangeInclusive<f64> = 0.0..=10.0;
 pub const STEP_RATE_SLIDER: RangeInclusive<f64> = 10.0..=480.0;
 /// The damping slider's range, per second.
 pub const DAMPING_SLIDER: RangeInclusive<f64> = 0.0..=10.0;
+/// Fastest fling of the mouse, pixels per second: within what the simulation accepts.
+pub const MAX_FLING_SPEED: f64 = 5_000.0;
+const _: () = assert!(MAX_FLING_SPEED <= MAX_SPEED);
 /// Fixed steps per second unless the player sets another rate.
 pub const DEFAULT_STEP_RATE: f64 = 60.0;
 

@@ -9,11 +9,10 @@ use bevy::math::DVec2;
 use proptest::prelude::*;
 
 use super::continuous::{StepSpec, Timeline};
-use super::discrete::resolve::resolve_overlaps;
 use super::geometry::circle::{
     Circle, circle_contact, circles_touch, collision_point, time_of_impact,
 };
-use super::geometry::impulse::normal_exchange;
+use super::geometry::impulse::{normal_exchange, resolve_overlaps};
 use super::geometry::wall::{contain_in_arena, wall_time_of_impact};
 use super::params::{MAX_SPEED, MassModel, RADIUS_RANGE};
 

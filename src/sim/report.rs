@@ -12,7 +12,8 @@ use super::ball::BallSnapshot;
 #[cfg(debug_assertions)]
 use super::ball::{Ball, Position, Velocity};
 use super::clock::SimClock;
-use super::geometry::impulse::wall_impulse;
+use super::geometry::circle::ContactGeometry;
+use super::geometry::impulse::{Exchange, wall_impulse};
 use super::geometry::wall::{Contained, Wall, wall_contact_point};
 use super::measure::SimStats;
 use super::messages::{BallCollision, WallCollision};
@@ -43,6 +44,19 @@ pub enum Hit {
 }
 
 impl Hit {
+    /// The hit a ball–ball exchange at `time` into the step records.
+    pub fn ball(a: u32, b: u32, time: f64, geometry: ContactGeometry, exchange: Exchange) -> Hit {
+        Hit::Ball {
+            a,
+            b,
+            time,
+            point: geometry.point,
+            normal: geometry.normal,
+            impulse: exchange.impulse,
+            closing_speed: exchange.closing_speed,
+        }
+    }
+
     /// The wall hits of a containment of ball `ball` (of `mass`) at `time` into the step, in
     /// the arena `[-half, half]`.
     pub fn walls_of(
@@ -85,7 +99,7 @@ pub struct StepLog {
     /// Discrete mode: every touching pair found; continuous mode: every ball–ball impact.
     pub contacts: Vec<ContactPoint>,
     /// A continuous step stopped handling impacts for some ball (see
-    /// [`MAX_HITS_PER_BALL`](super::continuous::timeline::MAX_HITS_PER_BALL)).
+    /// [`MAX_HITS_PER_BALL`](super::continuous::MAX_HITS_PER_BALL)).
     pub cut_short: bool,
 }
 

@@ -14,13 +14,12 @@ use rand::RngExt;
 use crate::app::scenes::SceneRequest;
 use crate::app::view::{Aim, AimGuide, PanelVisible, UiRng};
 use crate::sim::geometry::Circle;
+use crate::sim::params::MAX_FLING_SPEED;
 use crate::sim::spawn::fit_radius_at;
 use crate::sim::{Ball, BallState, Intent, Position, Radius, RunControl, SimParams, SpawnSettings};
 
 /// Fling speed per pixel of drag, per second: a 100 px drag flings at 300 px/s.
 pub const FLING_GAIN: f64 = 3.0;
-/// Fastest fling, pixels per second.
-pub const MAX_FLING_SPEED: f64 = 5_000.0;
 
 pub(super) fn plugin(app: &mut App) {
     app.add_systems(

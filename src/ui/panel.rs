@@ -21,7 +21,7 @@ use crate::app::view::{ColourMode, PANEL_WIDTH, PanelVisible, PlayArea, ViewSett
 use crate::diagnostics::frame_figures;
 use crate::sim::params::{
     BALL_COUNT_SLIDER, DAMPING_SLIDER, DEFAULT_STEP_RATE, GRAVITY_SLIDER, RADIUS_SLIDER,
-    SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
+    RESTITUTION_RANGE, SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
 };
 use crate::sim::{
     BallCountOutcome, CollisionMode, Intent, MassModel, RunControl, SimParams, Solver,
@@ -271,7 +271,7 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
             );
             ui.add(slider(&mut edited.gravity.x, GRAVITY_SLIDER).text("gravity x"));
             ui.add(slider(&mut edited.gravity.y, GRAVITY_SLIDER).text("gravity y"));
-            ui.add(slider(&mut edited.restitution, 0.0..=1.0).text("restitution"));
+            ui.add(slider(&mut edited.restitution, RESTITUTION_RANGE).text("restitution"));
             ui.horizontal(|ui| {
                 ui.label("mass");
                 for (model, name) in MassModel::ALL.into_iter().zip(["radius", "area", "unit"]) {

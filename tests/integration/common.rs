@@ -82,7 +82,7 @@ pub fn step(app: &mut App, steps: usize) {
     }
 }
 
-/// Loads a shipped scene by file name, optionally with another count and seed.
+/// Loads a shipped scene by file name.
 pub fn shipped_scene(name: &str) -> SceneFile {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("assets/scenes")

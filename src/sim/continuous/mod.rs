@@ -11,11 +11,14 @@
 //!   the balls each one redirects (`rerouted.rs` files those), then every ball to the end of
 //!   the step, and the balls written back.
 //!
+//! [`state`] holds the [`Timeline`] resource both halves work on.
+//!
 //! The [`Timeline`] works on plain arrays, so it is tested without an app.
 
 pub mod impact;
 pub mod predict;
 mod rerouted;
+pub mod state;
 pub mod timeline;
 
 use bevy::prelude::*;
@@ -24,7 +27,7 @@ use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
 use crate::sim::clock::SimClock;
 use crate::sim::params::SimParams;
 use crate::sim::report::{ContactPoint, Hit, StepLog};
-pub use timeline::{StepSpec, Timeline};
+pub use state::{MAX_HITS_PER_BALL, StepSpec, Timeline};
 
 /// Stage 2: every impact of the coming step that the balls' paths lead to.
 pub fn predict_impacts(

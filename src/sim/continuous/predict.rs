@@ -9,7 +9,7 @@ use std::cmp::Reverse;
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Prediction, approach_time, swept_circle};
-use super::timeline::{MAX_HITS_PER_BALL, StepSpec, Timeline};
+use super::state::{MAX_HITS_PER_BALL, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circles_touch, overlapping};
 use crate::sim::geometry::pairs::search_in_bands;
 use crate::sim::geometry::wall::wall_time_of_impact;

@@ -8,99 +8,17 @@
 //! when it was predicted; if either has been hit since, the prediction is stale and skipped.
 
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 use bevy::math::DVec2;
-use bevy::prelude::*;
 
 use super::impact::{Impact, Prediction};
-use super::rerouted::Rerouted;
-use crate::sim::discrete::resolve::{ball_hit, resolve_overlaps};
+use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
-use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::impulse::{normal_exchange, separate};
-use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
+use crate::sim::geometry::pairs::find_contacts;
 use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_in_arena};
-use crate::sim::params::{BroadPhase, MassModel, SimParams};
+use crate::sim::params::BroadPhase;
 use crate::sim::report::Hit;
-
-/// A ball takes at most this many hits in one step. Only an inelastic collapse (a pile
-/// pressed together by gravity, restitution below 1) comes near it; the step then ends for
-/// that ball without further impacts, and the overlaps left at the end get the discrete
-/// mode's response. [`SimStats::cut_short_steps`](crate::sim::SimStats::cut_short_steps)
-/// counts such steps.
-pub const MAX_HITS_PER_BALL: u32 = 16;
-
-/// What a step's timeline needs of the simulation's parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepSpec {
-    /// Seconds.
-    pub dt: f64,
-    /// Half the arena size, pixels.
-    pub half: DVec2,
-    pub restitution: f64,
-    pub mass_model: MassModel,
-}
-
-impl StepSpec {
-    pub fn new(params: &SimParams, dt: f64) -> Self {
-        Self {
-            dt,
-            half: params.half_extents(),
-            restitution: params.restitution,
-            mass_model: params.mass_model,
-        }
-    }
-}
-
-/// A ball on the step's timeline: where it is `clock` seconds into the step, and how many hits
-/// it has taken.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Mover {
-    pub center: DVec2,
-    pub velocity: DVec2,
-    pub radius: f64,
-    pub clock: f64,
-    pub hits: u32,
-}
-
-impl Mover {
-    pub fn circle(&self) -> Circle {
-        Circle::new(self.center, self.radius)
-    }
-
-    /// Where the ball is `time` seconds into the step.
-    #[inline]
-    pub fn center_at(&self, time: f64) -> DVec2 {
-        self.center + self.velocity * (time - self.clock)
-    }
-
-    pub fn advance(&mut self, time: f64) {
-        self.center = self.center_at(time);
-        self.clock = time;
-    }
-}
-
-/// The continuous mode's working state, kept between steps to reuse its buffers.
-#[derive(Resource, Debug, Default)]
-pub struct Timeline {
-    /// Each ball's circle swept over the whole step, sorted into cells.
-    pub(super) grid: UniformGrid,
-    pub(super) swept: Vec<Circle>,
-    /// Largest radius in `swept`.
-    pub(super) grid_reach: f64,
-    pub(super) predictions: Vec<Prediction>,
-    pub(super) queue: BinaryHeap<Reverse<Impact>>,
-    overlapping: Vec<(u32, u32)>,
-    /// Every ball on this step's timeline, by index: all a prediction reads of one ball in
-    /// one cache line.
-    pub(super) movers: Vec<Mover>,
-    pub(super) rerouted: Rerouted,
-    /// Contacts for the discrete response of a step cut short.
-    fallback: Vec<IndexedContact>,
-    /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
-    pub cut_short: bool,
-}
 
 impl Timeline {
     /// The response stage's part: handles the predicted impacts in time order, predicting
@@ -287,7 +205,7 @@ impl Timeline {
             velocities,
             spec.mass_model,
             spec.restitution,
-            |a, b, geometry, exchange| on_hit(ball_hit(a, b, spec.dt, geometry, exchange)),
+            |a, b, geometry, exchange| on_hit(Hit::ball(a, b, spec.dt, geometry, exchange)),
         );
     }
 
@@ -341,6 +259,7 @@ fn contain_at_the_end(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::params::MassModel;
 
     #[test]
     fn a_timeline_on_plain_arrays_bounces_a_fast_pair_and_keeps_energy() {

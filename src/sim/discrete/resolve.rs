@@ -8,71 +8,15 @@
 //! balls that changed back to their components in one pass. Records each exchange and wall
 //! hit in the [`StepLog`].
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::detect::Contacts;
 use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
 use crate::sim::clock::SimClock;
-use crate::sim::geometry::circle::{Circle, ContactGeometry, circle_contact};
-use crate::sim::geometry::impulse::{Exchange, normal_exchange, separate};
+use crate::sim::geometry::impulse::resolve_overlaps;
 use crate::sim::geometry::wall::contain_in_arena;
-use crate::sim::params::{MassModel, SimParams};
+use crate::sim::params::SimParams;
 use crate::sim::report::{Hit, StepLog};
-
-/// The discrete response on plain arrays: for each pair `(a, b)` of indices, in order, that
-/// still touches where the earlier pairs left it, the exchange along the normal (if the balls
-/// approach; `on_exchange` hears of it) and then separation shared by inverse mass. Both
-/// collision modes use it: discrete for every contact, continuous for a step it cut short.
-pub fn resolve_overlaps(
-    pairs: impl IntoIterator<Item = (u32, u32)>,
-    circles: &mut [Circle],
-    velocities: &mut [DVec2],
-    mass_model: MassModel,
-    restitution: f64,
-    mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
-) {
-    for (a, b) in pairs {
-        let (ia, ib) = (a as usize, b as usize);
-        // Earlier pairs may have moved either ball: work from where they are now.
-        let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
-            continue;
-        };
-        let inverse_mass_a = mass_model.inverse_mass(circles[ia].radius);
-        let inverse_mass_b = mass_model.inverse_mass(circles[ib].radius);
-        if let Some(exchange) = normal_exchange(
-            velocities[ia],
-            velocities[ib],
-            inverse_mass_a,
-            inverse_mass_b,
-            geometry.normal,
-            restitution,
-        ) {
-            velocities[ia] = exchange.velocity_a;
-            velocities[ib] = exchange.velocity_b;
-            on_exchange(a, b, geometry, exchange);
-        }
-        separate(
-            circles,
-            (ia, ib),
-            geometry,
-            (inverse_mass_a, inverse_mass_b),
-        );
-    }
-}
-
-/// The hit an exchange at `time` into the step records.
-pub fn ball_hit(a: u32, b: u32, time: f64, geometry: ContactGeometry, exchange: Exchange) -> Hit {
-    Hit::Ball {
-        a,
-        b,
-        time,
-        point: geometry.point,
-        normal: geometry.normal,
-        impulse: exchange.impulse,
-        closing_speed: exchange.closing_speed,
-    }
-}
 
 pub fn resolve_contacts(
     clock: Res<SimClock>,
@@ -110,7 +54,7 @@ pub fn resolve_contacts(
         velocities,
         mass_model,
         restitution,
-        |a, b, geometry, exchange| hits.push(ball_hit(a, b, step_end, geometry, exchange)),
+        |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange)),
     );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
     // the movement stage kept every ball inside, so only they need the walls again, and only

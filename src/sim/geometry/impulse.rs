@@ -1,13 +1,16 @@
 //! Impulses: the momentum a hit exchanges along the contact normal, between two balls or
 //! between a ball and a wall, and the separation of an overlapping pair shared by inverse
-//! mass. Pure functions over plain values.
+//! mass; and [`resolve_overlaps`], the discrete response over a list of pairs on plain arrays.
+//! Pure functions over plain values.
 //!
-//! Both modes' responses, the aiming guide and the property tests call these, so the impulse
-//! is written once.
+//! Both modes' responses (the continuous one falls back on `resolve_overlaps` when a step is
+//! cut short), the aiming guide and the property tests call these, so the impulse is written
+//! once.
 
 use bevy::math::DVec2;
 
-use super::circle::{Circle, ContactGeometry};
+use super::circle::{Circle, ContactGeometry, circle_contact};
+use crate::sim::params::MassModel;
 
 /// The result of [`normal_exchange`]: the new velocities and what the hit carried.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,6 +81,47 @@ pub fn separate(
     let (back, forward) = separation_shares(geometry.depth, inverse_mass_a, inverse_mass_b);
     circles[a].center -= geometry.normal * back;
     circles[b].center += geometry.normal * forward;
+}
+
+/// The discrete mode's response on plain arrays: for each pair `(a, b)` of indices, in order, that
+/// still touches where the earlier pairs left it, the exchange along the normal (if the balls
+/// approach; `on_exchange` hears of it) and then separation shared by inverse mass. Both
+/// collision modes use it: discrete for every contact, continuous for a step it cut short.
+pub fn resolve_overlaps(
+    pairs: impl IntoIterator<Item = (u32, u32)>,
+    circles: &mut [Circle],
+    velocities: &mut [DVec2],
+    mass_model: MassModel,
+    restitution: f64,
+    mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
+) {
+    for (a, b) in pairs {
+        let (ia, ib) = (a as usize, b as usize);
+        // Earlier pairs may have moved either ball: work from where they are now.
+        let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
+            continue;
+        };
+        let inverse_mass_a = mass_model.inverse_mass(circles[ia].radius);
+        let inverse_mass_b = mass_model.inverse_mass(circles[ib].radius);
+        if let Some(exchange) = normal_exchange(
+            velocities[ia],
+            velocities[ib],
+            inverse_mass_a,
+            inverse_mass_b,
+            geometry.normal,
+            restitution,
+        ) {
+            velocities[ia] = exchange.velocity_a;
+            velocities[ib] = exchange.velocity_b;
+            on_exchange(a, b, geometry, exchange);
+        }
+        separate(
+            circles,
+            (ia, ib),
+            geometry,
+            (inverse_mass_a, inverse_mass_b),
+        );
+    }
 }
 
 /// The impulse a wall gives a ball of `mass` arriving at `normal_speed` with restitution

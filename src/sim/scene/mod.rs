@@ -1,10 +1,10 @@
 //! Scene files: RON descriptions of an arena and its balls, written by hand or generated.
 //!
-//! [`SceneFile`] is the file as written (here: reading, parsing, writing back); building it
-//! (`build.rs`) validates it and draws the generated balls, giving a [`SceneSetup`], which
+//! [`SceneFile`] is the file as written (`file.rs`: reading, parsing, writing back); building
+//! it (`build.rs`) validates it and draws the generated balls, giving a [`SceneSetup`], which
 //! `apply` loads into a world; `check.rs` holds the checks on single values, `placement.rs`
-//! random placement without overlap, `audit.rs` the fuzzer's audit. Pure data until `apply`;
-//! nothing here runs in a schedule.
+//! random placement without overlap, `audit.rs` the fuzzer's audit. This file only declares
+//! and re-exports them. Pure data until `apply`; nothing here runs in a schedule.
 //!
 //! ```ron
 //! (

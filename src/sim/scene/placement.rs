@@ -1,5 +1,5 @@
 //! Placing balls without overlap: an incremental grid of the balls placed so far. Used by scene
-//! generation and by anything that adds balls to a running simulation (the panel, clicks).
+//! generation and by the ball-count slider, which adds balls to a running simulation.
 //! Pure data; runs in no schedule.
 
 use bevy::math::DVec2;
