@@ -8,6 +8,7 @@
 //! fixed steps by `Time<Fixed>::overstep_fraction`, so motion is smooth at any display rate.
 
 pub mod effects;
+pub mod interpolate;
 pub mod overlays;
 
 use bevy::asset::RenderAssetUsages;
@@ -21,6 +22,7 @@ use crate::app::view::{ColourMode, PlayArea, ViewSettings};
 use crate::sim::{
     Ball, BallId, Position, PreviousPosition, Radius, RunControl, SimParams, Velocity,
 };
+use interpolate::{drawn_position, interpolation_fraction};
 
 /// Side of the shared circle texture, texels: large enough that a ball 256 px wide is crisp.
 const CIRCLE_TEXTURE_SIZE: u32 = 256;
@@ -139,21 +141,6 @@ fn give_ball_a_sprite(
     ));
 }
 
-/// How far between the previous and the latest fixed step to draw: 1 (the latest state)
-/// while paused, since no step is under way.
-pub fn interpolation_fraction(fixed: &Time<Fixed>, run: &RunControl) -> f64 {
-    if run.paused {
-        1.0
-    } else {
-        fixed.overstep_fraction_f64().clamp(0.0, 1.0)
-    }
-}
-
-/// Where to draw a ball this frame.
-pub fn drawn_position(previous: &PreviousPosition, position: &Position, fraction: f64) -> Vec2 {
-    previous.0.lerp(position.0, fraction).as_vec2()
-}
-
 fn place_ball_sprites(
     fixed: Res<Time<Fixed>>,
     run: Res<RunControl>,
@@ -222,20 +209,6 @@ fn place_camera_and_floor(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn drawn_position_interpolates_between_steps() {
-        let previous = PreviousPosition(DVec2::new(0.0, 0.0));
-        let position = Position(DVec2::new(10.0, -4.0));
-        assert_eq!(
-            drawn_position(&previous, &position, 0.25),
-            Vec2::new(2.5, -1.0)
-        );
-        assert_eq!(
-            drawn_position(&previous, &position, 1.0),
-            Vec2::new(10.0, -4.0)
-        );
-    }
 
     #[test]
     fn heat_runs_from_blue_to_red_and_clamps() {

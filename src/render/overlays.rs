@@ -4,7 +4,7 @@
 
 use bevy::prelude::*;
 
-use super::{drawn_position, interpolation_fraction};
+use super::interpolate::{drawn_position, interpolation_fraction};
 use crate::app::view::{AimGuide, ViewSettings};
 use crate::sim::aim::{AimTarget, predict_first_hit, time_to_wall};
 use crate::sim::geometry::Circle;

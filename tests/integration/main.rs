@@ -7,6 +7,7 @@ mod common;
 mod continuous;
 #[cfg(feature = "gui")]
 mod game;
+mod house;
 mod physics;
 mod scenes;
 mod toy;
