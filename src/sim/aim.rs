@@ -86,10 +86,11 @@ pub fn predict_first_hit<T: Copy>(
 }
 
 /// Seconds until a ball of `radius` at `center` moving at `velocity` touches a wall of the
-/// arena `[-half, half]` (the simulation's own [`wall_time_of_impact`]); infinite when it
-/// meets none.
+/// arena `[-half, half]` along a straight path (the simulation's own [`wall_time_of_impact`]);
+/// infinite when it meets none.
 pub fn time_to_wall(center: DVec2, velocity: DVec2, radius: f64, half: DVec2) -> f64 {
-    wall_time_of_impact(center, velocity, radius, half).map_or(f64::INFINITY, |(time, _)| time)
+    wall_time_of_impact(center, velocity, radius, half, DVec2::ZERO)
+        .map_or(f64::INFINITY, |(time, _)| time)
 }
 
 #[cfg(test)]

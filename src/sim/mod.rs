@@ -10,7 +10,7 @@
 //!
 //! | stage | discrete | continuous |
 //! |---|---|---|
-//! | [`SimSystems::Movement`] | [`move_and_contain`](movement::move_and_contain): velocity, position, walls | [`integrate_velocities`](movement::integrate_velocities): velocity only |
+//! | [`SimSystems::Movement`] | [`move_and_contain`](movement::move_and_contain): velocity, position, walls | [`damp_velocities`](movement::damp_velocities): damping only |
 //! | [`SimSystems::Collision`] | [`detect_contacts`](discrete::detect::detect_contacts): grid, AABB, distance → [`Contacts`](discrete::detect::Contacts) | [`predict_impacts`](continuous::predict_impacts): every time of impact within the step |
 //! | [`SimSystems::Response`] | [`resolve_contacts`](discrete::resolve::resolve_contacts): exchange, separation, walls | [`run_timeline`](continuous::run_timeline): the impacts in time order |
 //! | [`SimSystems::Report`] | [`report_step`](report::report_step): messages, counters, contact points | the same |
@@ -27,8 +27,8 @@
 //! without changing it; [`scene`] scene files; [`params`] the parameters by owner.
 //!
 //! **Where gravity's work goes** (piles that rest and sleep): exact ballistic flight is pure
-//! maths beside the straight path it replaces (a `geometry/flight.rs` used by
-//! [`movement`] and the timeline's `Mover`); a contact solver both modes share is its own
+//! maths in [`geometry::flight`], used by the continuous timeline's `Mover`, its swept
+//! circles and the wall time of impact; a contact solver both modes share is its own
 //! folder and stage (`sim/resting/`, a `SimSystems::Resting` set between `Response` and
 //! `Report`, reading the contacts the modes record); sleeping is a filter on what the
 //! movement stage puts into the snapshot, so sleeping balls cost nothing in any stage.
@@ -112,7 +112,7 @@ impl Plugin for SimPlugin {
                     clock::start_step.before(Movement),
                     // The pipeline: each stage, the system of each mode.
                     stage(Movement, Discrete, movement::move_and_contain),
-                    stage(Movement, Continuous, movement::integrate_velocities),
+                    stage(Movement, Continuous, movement::damp_velocities),
                     stage(Collision, Discrete, discrete::detect::detect_contacts),
                     stage(Collision, Continuous, continuous::predict_impacts),
                     stage(Response, Discrete, discrete::resolve::resolve_contacts),

@@ -257,7 +257,7 @@ proptest! {
             prop_assert!(contained.position[axis].abs() <= room * (1.0 + ONE_HIT));
             prop_assert!(contained.velocity[axis].abs() <= velocity[axis].abs());
         }
-        if let Some((time, _)) = wall_time_of_impact(DVec2::from(position), velocity, radius, half) {
+        if let Some((time, _)) = wall_time_of_impact(DVec2::from(position), velocity, radius, half, DVec2::ZERO) {
             prop_assert!(time.is_finite() && time >= 0.0);
         }
     }
@@ -296,7 +296,7 @@ proptest! {
         e in restitution(),
         dt in prop_oneof![Just(1.0 / 60.0), 0.001..0.2f64],
     ) {
-        let spec = StepSpec { dt, half: DVec2::new(200.0, 50.0), restitution: e, mass_model: model };
+        let spec = StepSpec { dt, half: DVec2::new(200.0, 50.0), restitution: e, mass_model: model, gravity: DVec2::ZERO };
         let energy = |c: &[Circle], v: &[DVec2]| -> f64 {
             c.iter().zip(v).map(|(c, v)| 0.5 * model.mass(c.radius) * v.length_squared()).sum()
         };

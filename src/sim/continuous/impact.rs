@@ -8,13 +8,15 @@ use bevy::math::DVec2;
 use crate::sim::geometry::circle::{Circle, MIN_APPROACH_SPEED, time_of_impact};
 use crate::sim::geometry::wall::Wall;
 
-/// The smallest circle holding `circle` wherever it is while moving at `velocity` for
-/// `seconds`: centred halfway along the path.
+/// A circle holding `circle` wherever it is while flying at `velocity` under `gravity` for
+/// `seconds`: centred halfway along the chord of its parabola, wide enough for the chord and
+/// for the parabola's bulge from it (`|g|·T²/8`). Without gravity, the smallest such circle.
 #[inline]
-pub fn swept_circle(circle: Circle, velocity: DVec2, seconds: f64) -> Circle {
+pub fn swept_circle(circle: Circle, velocity: DVec2, gravity: DVec2, seconds: f64) -> Circle {
+    let half = 0.5 * seconds;
     Circle::new(
-        circle.center + velocity * (0.5 * seconds),
-        circle.radius + velocity.length() * (0.5 * seconds),
+        circle.center + velocity * half + gravity * (half * half),
+        circle.radius + velocity.length() * half + gravity.length() * (1.5 * half * half),
     )
 }
 
@@ -113,6 +115,8 @@ pub enum Prediction {
 
 #[cfg(test)]
 mod tests {
+    use crate::sim::geometry::flight::position_after;
+
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
 
@@ -139,5 +143,28 @@ mod tests {
         let order: Vec<(u32, u32)> =
             std::iter::from_fn(|| queue.pop().map(|Reverse(i)| (i.a, i.other))).collect();
         assert_eq!(order, [(7, 9), (1, 2), (1, 8), (3, 4)]);
+    }
+
+    #[test]
+    fn the_swept_circle_holds_the_whole_parabola() {
+        let circle = Circle::new(DVec2::new(3.0, -7.0), 2.5);
+        for (velocity, gravity) in [
+            (DVec2::new(300.0, 40.0), DVec2::new(0.0, -500.0)),
+            (DVec2::new(0.0, 0.0), DVec2::new(-3000.0, 3000.0)),
+            (DVec2::new(-50.0, 900.0), DVec2::new(0.0, -10000.0)),
+            (DVec2::new(20.0, -20.0), DVec2::ZERO),
+        ] {
+            let seconds = 1.0 / 60.0;
+            let swept = swept_circle(circle, velocity, gravity, seconds);
+            for k in 0..=100 {
+                let t = seconds * k as f64 / 100.0;
+                let center = position_after(circle.center, velocity, gravity, t);
+                let reach = center.distance(swept.center) + circle.radius;
+                assert!(
+                    reach <= swept.radius * (1.0 + 1e-12),
+                    "{velocity} {gravity} at {t}"
+                );
+            }
+        }
     }
 }

@@ -1,8 +1,10 @@
 //! The continuous mode: each fixed step as a timeline of impacts, handled in time order, so
 //! nothing tunnels or overlaps and, with restitution 1, energy is kept to rounding.
 //!
-//! The movement stage only updates velocities (gravity, damping), so every ball's path over
-//! the step is a straight segment. Then:
+//! The movement stage only damps velocities, so every ball's path over the step is a parabola
+//! under gravity (a straight segment without): exact free flight. All balls feel the same
+//! gravity, so two balls approach in a straight line and their time of impact is the
+//! straight-line one; a wall's is the first root of a quadratic. Then:
 //!
 //! - stage 2, [`predict_impacts`] ([`predict`]): every approaching pair's and every ball's
 //!   wall time of impact within the step, found through the grid of swept circles

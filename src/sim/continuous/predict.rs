@@ -29,7 +29,7 @@ impl Timeline {
             circles
                 .iter()
                 .zip(velocities)
-                .map(|(circle, velocity)| swept_circle(*circle, *velocity, dt)),
+                .map(|(circle, velocity)| swept_circle(*circle, *velocity, spec.gravity, dt)),
         );
         self.grid_reach = self.swept.iter().map(|s| s.radius).fold(0.0, f64::max);
         self.grid.rebuild(&self.swept);
@@ -53,9 +53,13 @@ impl Timeline {
             });
         });
         for (index, (circle, velocity)) in circles.iter().zip(velocities).enumerate() {
-            if let Some((time, wall)) =
-                wall_time_of_impact(circle.center, *velocity, circle.radius, spec.half)
-                && time <= dt
+            if let Some((time, wall)) = wall_time_of_impact(
+                circle.center,
+                *velocity,
+                circle.radius,
+                spec.half,
+                spec.gravity,
+            ) && time <= dt
             {
                 let impact = Impact::with_wall(time, index, 0, wall);
                 self.predictions.push(Prediction::Impact(impact));
@@ -73,9 +77,13 @@ impl Timeline {
         }
         let (circle, velocity) = (mover.circle(), mover.velocity);
         let queue = &mut self.queue;
-        if let Some((time, wall)) =
-            wall_time_of_impact(circle.center, velocity, circle.radius, spec.half)
-            && now + time <= spec.dt
+        if let Some((time, wall)) = wall_time_of_impact(
+            circle.center,
+            velocity,
+            circle.radius,
+            spec.half,
+            spec.gravity,
+        ) && now + time <= spec.dt
         {
             queue.push(Reverse(Impact::with_wall(
                 now + time,
@@ -85,7 +93,7 @@ impl Timeline {
             )));
         }
         let rest = spec.dt - now;
-        let mut swept = swept_circle(circle, velocity, rest);
+        let mut swept = swept_circle(circle, velocity, spec.gravity, rest);
         swept.radius += SWEPT_MARGIN;
         self.rerouted.insert(
             self.grid.cell_index(swept.center),
@@ -100,8 +108,10 @@ impl Timeline {
                 return;
             }
             let other_mover = &movers[other_index];
-            let other_circle = Circle::new(other_mover.center_at(now), other_mover.radius);
-            let Some(time) = approach_time(circle, velocity, other_circle, other_mover.velocity)
+            let other_circle =
+                Circle::new(other_mover.center_at(now, spec.gravity), other_mover.radius);
+            let other_velocity = other_mover.velocity_at(now, spec.gravity);
+            let Some(time) = approach_time(circle, velocity, other_circle, other_velocity)
                 .map(|t| now + t)
                 .filter(|&t| t <= spec.dt)
             else {

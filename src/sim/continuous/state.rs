@@ -11,6 +11,7 @@ use bevy::prelude::*;
 use super::impact::{Impact, Prediction};
 use super::rerouted::Rerouted;
 use crate::sim::geometry::Circle;
+use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::IndexedContact;
 use crate::sim::params::{MassModel, SimParams};
@@ -31,6 +32,8 @@ pub struct StepSpec {
     pub half: DVec2,
     pub restitution: f64,
     pub mass_model: MassModel,
+    /// Pixels per second squared, the same for every ball: each one's path is a parabola.
+    pub gravity: DVec2,
 }
 
 impl StepSpec {
@@ -40,6 +43,7 @@ impl StepSpec {
             half: params.half_extents(),
             restitution: params.restitution,
             mass_model: params.mass_model,
+            gravity: params.gravity,
         }
     }
 }
@@ -60,14 +64,21 @@ impl Mover {
         Circle::new(self.center, self.radius)
     }
 
-    /// Where the ball is `time` seconds into the step.
+    /// Where the ball is `time` seconds into the step, in free flight under `gravity`.
     #[inline]
-    pub fn center_at(&self, time: f64) -> DVec2 {
-        self.center + self.velocity * (time - self.clock)
+    pub fn center_at(&self, time: f64, gravity: DVec2) -> DVec2 {
+        position_after(self.center, self.velocity, gravity, time - self.clock)
     }
 
-    pub fn advance(&mut self, time: f64) {
-        self.center = self.center_at(time);
+    /// Its velocity then.
+    #[inline]
+    pub fn velocity_at(&self, time: f64, gravity: DVec2) -> DVec2 {
+        velocity_after(self.velocity, gravity, time - self.clock)
+    }
+
+    pub fn advance(&mut self, time: f64, gravity: DVec2) {
+        self.center = self.center_at(time, gravity);
+        self.velocity = self.velocity_at(time, gravity);
         self.clock = time;
     }
 }

@@ -105,7 +105,7 @@ impl Timeline {
     ) {
         let (a, now) = (impact.a as usize, impact.time);
         let mover = &mut self.movers[a];
-        mover.advance(now);
+        mover.advance(now, spec.gravity);
         let mass = spec.mass_model.mass(mover.radius);
         let Some(bounce) = bounce_off_wall(
             mover.circle(),
@@ -134,8 +134,8 @@ impl Timeline {
     /// centres if they still approach.
     fn collide(&mut self, impact: Impact, spec: StepSpec, on_hit: &mut impl FnMut(Hit)) {
         let (a, b, now) = (impact.a as usize, impact.other as usize, impact.time);
-        self.movers[a].advance(now);
-        self.movers[b].advance(now);
+        self.movers[a].advance(now, spec.gravity);
+        self.movers[b].advance(now, spec.gravity);
         let (ma, mb) = (self.movers[a], self.movers[b]);
         let offset = mb.center - ma.center;
         let normal = contact_normal(offset, offset.length());
@@ -178,7 +178,7 @@ impl Timeline {
             .zip(velocities.iter_mut())
             .zip(&mut self.movers)
         {
-            mover.advance(spec.dt);
+            mover.advance(spec.dt, spec.gravity);
             (circle.center, *velocity) = (mover.center, mover.velocity);
         }
     }
@@ -268,6 +268,7 @@ mod tests {
             half: DVec2::new(1_000.0, 1_000.0),
             restitution: 1.0,
             mass_model: MassModel::Radius,
+            gravity: DVec2::ZERO,
         };
         let mut circles = vec![
             Circle::new(DVec2::new(-100.0, 0.0), 5.0),

@@ -1,9 +1,10 @@
-//! Pure geometry and mechanics, apart from any system: circles ([`circle`]), the arena's walls
-//! ([`wall`]), impulses ([`impulse`]), the uniform grid ([`grid`]) and the touching pairs it
+//! Pure geometry and mechanics, apart from any system: circles ([`circle`]), free flight under
+//! gravity ([`flight`]), the arena's walls ([`wall`]), impulses ([`impulse`]), the uniform grid ([`grid`]) and the touching pairs it
 //! finds ([`pairs`]). Plain functions over plain values, each with its unit tests; every stage,
 //! the aiming guide, scene placement and the measurements are built from them.
 
 pub mod circle;
+pub mod flight;
 pub mod grid;
 pub mod impulse;
 pub mod pairs;

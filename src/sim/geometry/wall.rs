@@ -9,6 +9,7 @@
 use bevy::math::DVec2;
 
 use super::circle::{Circle, MIN_APPROACH_SPEED};
+use super::flight::time_to_reach;
 use super::impulse::wall_impulse;
 
 /// The four sides of the arena.
@@ -109,32 +110,41 @@ pub fn wall_contact_point(wall: Wall, position: DVec2, half: DVec2) -> DVec2 {
     }
 }
 
-/// Seconds until a ball at `position` moving at `velocity` touches a wall of the arena
-/// `[-half, half]`, and which wall: zero if it already touches (or crosses) a wall it moves
-/// into. `None` if it moves into no wall (slower than [`MIN_APPROACH_SPEED`] counts as not
-/// moving), or only along axes where it is wider than the arena (containment centres those).
+/// Seconds until a ball at `position` moving at `velocity` under `gravity` touches a wall of
+/// the arena `[-half, half]`, and which wall: zero if it already touches (or crosses) a wall
+/// it moves into, or rests against one that gravity pushes it into. `None` if it reaches no
+/// wall (slower than [`MIN_APPROACH_SPEED`] without gravity counts as not moving), or only
+/// along axes where it is wider than the arena (containment centres those). Along an axis
+/// with gravity the path is a parabola and the time the first root of a quadratic
+/// ([`time_to_reach`]).
 pub fn wall_time_of_impact(
     position: DVec2,
     velocity: DVec2,
     radius: f64,
     half: DVec2,
+    gravity: DVec2,
 ) -> Option<(f64, Wall)> {
     let mut first: Option<(f64, Wall)> = None;
     for (axis, low_wall, high_wall) in [(0, Wall::Left, Wall::Right), (1, Wall::Bottom, Wall::Top)]
     {
         let limit = half[axis] - radius;
-        let speed = velocity[axis];
-        if limit <= 0.0 || speed.abs() <= MIN_APPROACH_SPEED {
+        if limit <= 0.0 {
             continue;
         }
-        let (gap, wall) = if speed > 0.0 {
-            (limit - position[axis], high_wall)
-        } else {
-            (limit + position[axis], low_wall)
-        };
-        let time = (gap / speed.abs()).max(0.0);
-        if first.is_none_or(|(earliest, _)| time < earliest) {
-            first = Some((time, wall));
+        for (side, wall) in [(1.0, high_wall), (-1.0, low_wall)] {
+            // Distance to the wall, speed and acceleration towards it.
+            let gap = limit - side * position[axis];
+            let reached = time_to_reach(
+                gap,
+                side * velocity[axis],
+                side * gravity[axis],
+                MIN_APPROACH_SPEED,
+            );
+            if let Some(time) = reached
+                && first.is_none_or(|(earliest, _)| time < earliest)
+            {
+                first = Some((time, wall));
+            }
         }
     }
     first
@@ -283,30 +293,54 @@ mod tests {
     fn wall_time_is_the_gap_over_the_speed_toward_the_nearer_wall() {
         // 90 px to the right wall's limit at 30 px/s; 40 px to the top at 10 px/s.
         let (time, wall) =
-            wall_time_of_impact(DVec2::ZERO, DVec2::new(30.0, 10.0), 10.0, HALF).unwrap();
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(30.0, 10.0), 10.0, HALF, DVec2::ZERO)
+                .unwrap();
         assert_eq!((time, wall), (3.0, Wall::Right));
-        let (time, wall) =
-            wall_time_of_impact(DVec2::ZERO, DVec2::new(-1.0, -20.0), 10.0, HALF).unwrap();
+        let (time, wall) = wall_time_of_impact(
+            DVec2::ZERO,
+            DVec2::new(-1.0, -20.0),
+            10.0,
+            HALF,
+            DVec2::ZERO,
+        )
+        .unwrap();
         assert_eq!((time, wall), (2.0, Wall::Bottom));
         // Already through a wall and still moving into it: now. Moving away: never.
         let past = DVec2::new(95.0, 0.0);
         assert_eq!(
-            wall_time_of_impact(past, DVec2::X, 10.0, HALF),
+            wall_time_of_impact(past, DVec2::X, 10.0, HALF, DVec2::ZERO),
             Some((0.0, Wall::Right))
         );
         assert_eq!(
-            wall_time_of_impact(past, DVec2::NEG_X, 10.0, HALF).map(|h| h.1),
+            wall_time_of_impact(past, DVec2::NEG_X, 10.0, HALF, DVec2::ZERO).map(|h| h.1),
             Some(Wall::Left)
         );
         assert_eq!(
-            wall_time_of_impact(DVec2::ZERO, DVec2::ZERO, 10.0, HALF),
+            wall_time_of_impact(DVec2::ZERO, DVec2::ZERO, 10.0, HALF, DVec2::ZERO),
             None
         );
         // Wider than the arena along y: only x counts.
         assert_eq!(
-            wall_time_of_impact(DVec2::ZERO, DVec2::new(0.0, 5.0), 60.0, HALF),
+            wall_time_of_impact(DVec2::ZERO, DVec2::new(0.0, 5.0), 60.0, HALF, DVec2::ZERO),
             None
         );
+    }
+
+    #[test]
+    fn under_gravity_a_ball_falls_to_the_floor_and_one_resting_on_it_is_pressed_now() {
+        let g = DVec2::new(0.0, -10.0);
+        // 80 px above the floor's limit (-40), at rest: sqrt(2·80/10) = 4 s.
+        let hit = wall_time_of_impact(DVec2::new(0.0, 40.0), DVec2::ZERO, 10.0, HALF, g);
+        assert_eq!(hit, Some((4.0, Wall::Bottom)));
+        // Thrown up at 10 px/s from 10 px below the ceiling's limit: it turns back 5 px short
+        // and falls to the floor; at 20 px/s it reaches the ceiling first.
+        let hit = wall_time_of_impact(DVec2::new(0.0, 30.0), DVec2::new(0.0, 10.0), 10.0, HALF, g);
+        assert_eq!(hit.map(|h| h.1), Some(Wall::Bottom));
+        let hit = wall_time_of_impact(DVec2::new(0.0, 30.0), DVec2::new(0.0, 20.0), 10.0, HALF, g);
+        assert_eq!(hit.map(|h| h.1), Some(Wall::Top));
+        // Resting on the floor: pressed into it now.
+        let hit = wall_time_of_impact(DVec2::new(0.0, -40.0), DVec2::ZERO, 10.0, HALF, g);
+        assert_eq!(hit, Some((0.0, Wall::Bottom)));
     }
 
     #[test]
