@@ -37,6 +37,14 @@ pub struct RunReport {
     pub momentum_end: [f64; 2],
     /// Largest remaining overlap at the end, divided by the smaller radius of the pair.
     pub max_overlap_rel: f64,
+    /// Mean of the same over the overlapping pairs.
+    pub mean_overlap_rel: f64,
+    /// Balls faster than 1 px/s at the end.
+    pub moving: usize,
+    /// Root mean square speed at the end, pixels per second.
+    pub rms_speed: f64,
+    /// Balls asleep at the end.
+    pub sleeping: usize,
     /// Balls whose centre is outside the arena at the end.
     pub escaped: usize,
     /// Total normal impulse on the walls / (perimeter x simulated time).
@@ -106,6 +114,10 @@ pub fn run_scene_with_threads(
         momentum_start: start.momentum.to_array(),
         momentum_end: end.momentum.to_array(),
         max_overlap_rel: end.max_overlap_rel,
+        mean_overlap_rel: end.mean_overlap_rel,
+        moving: end.moving,
+        rms_speed: end.rms_speed,
+        sleeping: end.sleeping,
         escaped: end.escaped,
         pressure: stats.pressure(arena_size, clock.elapsed),
         temperature: end.temperature(),

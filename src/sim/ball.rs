@@ -11,7 +11,7 @@ use super::geometry::Circle;
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
-#[require(BallId, Position, PreviousPosition, Velocity, Radius)]
+#[require(BallId, Position, PreviousPosition, Velocity, Radius, Rest)]
 pub struct Ball;
 
 /// A ball's stable number, in spawn order: what reports and dumps call it.
@@ -37,6 +37,39 @@ pub struct Radius(pub f64);
 impl Default for Radius {
     fn default() -> Self {
         Radius(10.0)
+    }
+}
+
+/// Whether a ball flies, rests on others in the contact solver, or sleeps (see
+/// [`resting`](super::resting)). Free balls move in their mode's stages; resting and
+/// sleeping ones hold still there (an impact can free them) and only the resting stage
+/// moves resting ones.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rest {
+    pub state: RestState,
+    /// Seconds it has stayed slower than the sleep speed while resting.
+    pub still_for: f64,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RestState {
+    /// In free flight: the mode's stages move it.
+    #[default]
+    Free,
+    /// Touching others or a wall, slow: the resting solver moves it.
+    Resting,
+    /// Asleep with the rest of its island of touching balls: nothing moves it.
+    Asleep { island: u32 },
+}
+
+impl Rest {
+    /// Whether the mode's stages hold it still (resting or asleep).
+    pub fn is_held(&self) -> bool {
+        self.state != RestState::Free
+    }
+
+    pub fn is_asleep(&self) -> bool {
+        matches!(self.state, RestState::Asleep { .. })
     }
 }
 
@@ -84,6 +117,9 @@ pub struct BallSnapshot {
     pub circles: Vec<Circle>,
     /// Pixels per second.
     pub velocities: Vec<DVec2>,
+    /// Whether the ball is held still in the mode's stages (resting or asleep). The
+    /// response clears it for a ball an impact sets moving.
+    pub held: Vec<bool>,
 }
 
 impl BallSnapshot {
@@ -91,12 +127,14 @@ impl BallSnapshot {
         self.entities.clear();
         self.circles.clear();
         self.velocities.clear();
+        self.held.clear();
     }
 
-    pub fn push(&mut self, entity: Entity, circle: Circle, velocity: DVec2) {
+    pub fn push(&mut self, entity: Entity, circle: Circle, velocity: DVec2, held: bool) {
         self.entities.push(entity);
         self.circles.push(circle);
         self.velocities.push(velocity);
+        self.held.push(held);
     }
 }
 

@@ -1,13 +1,17 @@
 //! What a player (or any driver of the simulation) asks of it: fling a ball, add one, set the
 //! ball count. The UI sends [`Intent`] messages; [`apply_intents`] applies them in the fixed
 //! step, before the stages, paused or not, so the stages never see a ball change mid-step and
-//! the UI never writes simulation components itself.
+//! the UI never writes simulation components itself. A flung ball that rests or sleeps flies,
+//! and its sleeping island wakes; a new ball wakes the islands it touches (the resting stage
+//! sees to that); changing the count wakes every island, since balls may have gone from
+//! under others.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{BallState, Velocity};
+use super::ball::{BallState, Rest, RestState, Velocity};
 use super::params::{MAX_SPEED, RADIUS_RANGE};
+use super::resting::RestingState;
 use super::spawn::{set_ball_count, spawn_ball};
 
 /// A request to change the simulation's balls.
@@ -44,6 +48,7 @@ fn apply(world: &mut World, intent: Intent) {
                 && velocity.is_finite()
             {
                 current.0 = velocity;
+                wake_and_free(world, ball);
             }
         }
         Intent::Spawn(state) => {
@@ -57,7 +62,22 @@ fn apply(world: &mut World, intent: Intent) {
         }
         Intent::SetBallCount(wanted) => {
             let reached = set_ball_count(world, wanted);
+            world.resource_mut::<RestingState>().wake_all = true;
             world.insert_resource(BallCountOutcome { wanted, reached });
         }
+    }
+}
+
+/// Sets `ball` flying; if it slept, its island wakes at the next step.
+fn wake_and_free(world: &mut World, ball: Entity) {
+    let Some(mut rest) = world.get_mut::<Rest>(ball) else {
+        return;
+    };
+    let state = std::mem::take(&mut *rest).state;
+    if let RestState::Asleep { island } = state {
+        world
+            .resource_mut::<RestingState>()
+            .wake_requests
+            .push(island);
     }
 }

@@ -13,6 +13,7 @@
 //! | [`SimSystems::Movement`] | [`move_and_contain`](movement::move_and_contain): velocity, position, walls | [`damp_velocities`](movement::damp_velocities): damping only |
 //! | [`SimSystems::Collision`] | [`detect_contacts`](discrete::detect::detect_contacts): grid, AABB, distance → [`Contacts`](discrete::detect::Contacts) | [`predict_impacts`](continuous::predict_impacts): every time of impact within the step |
 //! | [`SimSystems::Response`] | [`resolve_contacts`](discrete::resolve::resolve_contacts): exchange, separation, walls | [`run_timeline`](continuous::run_timeline): the impacts in time order |
+//! | [`SimSystems::Resting`] | [`rest_and_sleep`](resting::rest_and_sleep): the resting solver, who rests next step, sleep | the same |
 //! | [`SimSystems::Report`] | [`report_step`](report::report_step): messages, counters, contact points | the same |
 //! | around the stages | the clock's `start_step` before, `take_pending_step` and `end_step` in `Report`; a finiteness assertion in debug builds | the same |
 //!
@@ -26,12 +27,11 @@
 //! [`discrete`] and [`continuous`] one folder per mode; [`measure`] what reads the state
 //! without changing it; [`scene`] scene files; [`params`] the parameters by owner.
 //!
-//! **Where gravity's work goes** (piles that rest and sleep): exact ballistic flight is pure
-//! maths in [`geometry::flight`], used by the continuous timeline's `Mover`, its swept
-//! circles and the wall time of impact; a contact solver both modes share is its own
-//! folder and stage (`sim/resting/`, a `SimSystems::Resting` set between `Response` and
-//! `Report`, reading the contacts the modes record); sleeping is a filter on what the
-//! movement stage puts into the snapshot, so sleeping balls cost nothing in any stage.
+//! **Gravity and piles**: exact ballistic flight is pure maths in [`geometry::flight`], used
+//! by the continuous timeline's `Mover`, its swept circles and the wall time of impact.
+//! Balls that rest on others, and islands of them that sleep, are [`resting`]'s: both modes
+//! hold them still (their [`Rest`](ball::Rest) says so), and the resting stage alone moves
+//! the resting ones, with a soft contact solver.
 
 pub mod aim;
 pub mod ball;
@@ -47,6 +47,7 @@ pub mod params;
 #[cfg(test)]
 mod properties;
 pub mod report;
+pub mod resting;
 pub mod scene;
 pub mod spawn;
 
@@ -56,7 +57,9 @@ use bevy::ecs::schedule::{
 use bevy::ecs::system::ScheduleSystem;
 use bevy::prelude::*;
 
-pub use ball::{Ball, BallId, BallState, Position, PreviousPosition, Radius, Velocity};
+pub use ball::{
+    Ball, BallId, BallState, Position, PreviousPosition, Radius, Rest, RestState, Velocity,
+};
 pub use clock::SimClock;
 pub use intents::{BallCountOutcome, Intent};
 pub use measure::{SimStats, StateSummary};
@@ -83,6 +86,9 @@ pub enum SimSystems {
     /// Exchange momentum along contact normals and separate overlapping pairs (discrete), or
     /// handle the impacts in time order (continuous).
     Response,
+    /// Move the balls that rest on others with the contact solver; decide who rests next
+    /// step; put still islands to sleep and wake disturbed ones.
+    Resting,
     /// Turn what the step recorded into messages and counters; advance the clock; check
     /// invariants in debug builds.
     Report,
@@ -100,12 +106,15 @@ pub struct SimPlugin;
 impl Plugin for SimPlugin {
     fn build(&self, app: &mut App) {
         use CollisionMode::{Continuous, Discrete};
-        use SimSystems::{Collision, Movement, Report, Response};
+        use SimSystems::{Collision, Movement, Report, Response, Resting};
         add_resources_and_messages(app);
         let mut schedule = Schedule::new(SimSchedule);
         schedule.set_executor(SingleThreadedExecutor::default());
         app.add_schedule(schedule)
-            .configure_sets(SimSchedule, (Movement, Collision, Response, Report).chain())
+            .configure_sets(
+                SimSchedule,
+                (Movement, Collision, Response, Resting, Report).chain(),
+            )
             .add_systems(
                 SimSchedule,
                 (
@@ -117,6 +126,7 @@ impl Plugin for SimPlugin {
                     stage(Collision, Continuous, continuous::predict_impacts),
                     stage(Response, Discrete, discrete::resolve::resolve_contacts),
                     stage(Response, Continuous, continuous::run_timeline),
+                    resting::rest_and_sleep.in_set(Resting),
                     (report::report_step, take_pending_step, clock::end_step)
                         .chain()
                         .in_set(Report),
@@ -147,6 +157,7 @@ fn add_resources_and_messages(app: &mut App) {
         .init_resource::<discrete::detect::Contacts>()
         .init_resource::<discrete::detect::DetectionGrid>()
         .init_resource::<continuous::Timeline>()
+        .init_resource::<resting::RestingState>()
         .init_resource::<SpawnSettings>()
         .init_resource::<BallCountOutcome>()
         .add_message::<Intent>()

@@ -8,19 +8,22 @@
 //!   is a parabola under gravity that the timeline follows impact by impact.
 //!
 //! Damping is one factor a step in both; [`Motion`] says why only the continuous mode's
-//! flight is exact.
+//! flight is exact. Balls that rest or sleep ([`Rest::is_held`]) are not moved here: the
+//! resting stage moves the resting ones, nothing the sleeping ones. A ball meeting a wall
+//! slower than the resting speed stops against it instead of bouncing.
 //!
 //! Runs in [`SimSystems::Movement`](super::SimSystems::Movement).
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Velocity};
+use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Rest, Velocity};
 use super::clock::SimClock;
 use super::geometry::Circle;
-use super::geometry::wall::contain_in_arena;
+use super::geometry::wall::contain_at_rest;
 use super::params::SimParams;
 use super::report::{Hit, StepLog};
+use super::resting::rest_speed;
 
 /// The balls as the movement stage sees them.
 type MovingBalls<'w, 's> = Query<
@@ -32,6 +35,7 @@ type MovingBalls<'w, 's> = Query<
         &'static mut PreviousPosition,
         &'static mut Velocity,
         &'static Radius,
+        &'static Rest,
     ),
     With<Ball>,
 >;
@@ -91,24 +95,37 @@ pub fn move_and_contain(
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
     let half = params.half_extents();
+    let rest_speed = rest_speed(&params, clock.dt);
     let (snapshot, log) = (&mut *snapshot, &mut *log);
     snapshot.clear();
-    for (ball, mut position, mut previous, mut velocity, radius) in &mut balls {
+    for (ball, mut position, mut previous, mut velocity, radius, rest) in &mut balls {
         previous.0 = position.0;
-        let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
-        let contained = contain_in_arena(moved, new_velocity, radius.0, half, params.restitution);
-        (position.0, velocity.0) = (contained.position, contained.velocity);
-        if contained.hits != [None, None] {
-            log.hits.extend(Hit::walls_of(
-                snapshot.entities.len() as u32,
-                &contained,
-                motion.dt,
+        let held = rest.is_held();
+        if !held {
+            let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
+            let contained = contain_at_rest(
+                moved,
+                new_velocity,
+                radius.0,
                 half,
                 params.restitution,
-                params.mass_model.mass(radius.0),
-            ));
+                rest_speed,
+            );
+            (position.0, velocity.0) = (contained.position, contained.velocity);
+            if contained.hits != [None, None] {
+                let mass = params.mass_model.mass(radius.0);
+                log.resting_wall_impulse += contained.resting_impulse(mass);
+                log.hits.extend(Hit::walls_of(
+                    snapshot.entities.len() as u32,
+                    &contained,
+                    motion.dt,
+                    half,
+                    params.restitution,
+                    mass,
+                ));
+            }
         }
-        snapshot.push(ball, Circle::new(position.0, radius.0), velocity.0);
+        snapshot.push(ball, Circle::new(position.0, radius.0), velocity.0, held);
     }
 }
 
@@ -123,10 +140,13 @@ pub fn damp_velocities(
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
     let snapshot = &mut *snapshot;
     snapshot.clear();
-    for (ball, position, mut previous, mut velocity, radius) in &mut balls {
+    for (ball, position, mut previous, mut velocity, radius, rest) in &mut balls {
         previous.0 = position.0;
-        velocity.0 = motion.damped(velocity.0);
-        snapshot.push(ball, Circle::new(position.0, radius.0), velocity.0);
+        let held = rest.is_held();
+        if !held {
+            velocity.0 = motion.damped(velocity.0);
+        }
+        snapshot.push(ball, Circle::new(position.0, radius.0), velocity.0, held);
     }
 }
 

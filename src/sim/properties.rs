@@ -149,7 +149,7 @@ proptest! {
         let masses = [model.mass(a.radius), model.mass(b.radius)];
         let mut circles = [a, b];
         let mut velocities = [va, vb];
-        resolve_overlaps([(0, 1)], &mut circles, &mut velocities, model, e, |_, _, _, _| {});
+        resolve_overlaps([(0, 1)], &mut circles, &mut velocities, &mut [false; 2], (model, e, 0.0), |_, _, _, _| {});
         prop_assert!(all_finite(&velocities) && all_finite(&[circles[0].center, circles[1].center]));
         let drift = (momentum(masses, velocities) - momentum(masses, [va, vb])).length();
         prop_assert!(drift <= ONE_HIT * momentum_scale(masses, [va, vb]), "momentum drift {drift}");
@@ -175,8 +175,8 @@ proptest! {
         prop_assume!(a.center != b.center);
         let mut forward = ([a, b], [va, vb]);
         let mut swapped = ([b, a], [vb, va]);
-        resolve_overlaps([(0, 1)], &mut forward.0, &mut forward.1, model, e, |_, _, _, _| {});
-        resolve_overlaps([(0, 1)], &mut swapped.0, &mut swapped.1, model, e, |_, _, _, _| {});
+        resolve_overlaps([(0, 1)], &mut forward.0, &mut forward.1, &mut [false; 2], (model, e, 0.0), |_, _, _, _| {});
+        resolve_overlaps([(0, 1)], &mut swapped.0, &mut swapped.1, &mut [false; 2], (model, e, 0.0), |_, _, _, _| {});
         let scale = va.length() + vb.length();
         for (mine, theirs) in [(0, 1), (1, 0)] {
             prop_assert!(forward.1[mine].distance(swapped.1[theirs]) <= ONE_HIT * scale);
@@ -203,7 +203,7 @@ proptest! {
         let mut circles = [a, b];
         let mut velocities = [va, vb];
         let mut exchanges = 0;
-        resolve_overlaps([(0, 1)], &mut circles, &mut velocities, model, e, |_, _, _, _| exchanges += 1);
+        resolve_overlaps([(0, 1)], &mut circles, &mut velocities, &mut [false; 2], (model, e, 0.0), |_, _, _, _| exchanges += 1);
         prop_assert_eq!(exchanges, 0);
         prop_assert_eq!(velocities, [va, vb]);
         prop_assert_eq!(time_of_impact(a, va, b, vb), None);
@@ -296,7 +296,7 @@ proptest! {
         e in restitution(),
         dt in prop_oneof![Just(1.0 / 60.0), 0.001..0.2f64],
     ) {
-        let spec = StepSpec { dt, half: DVec2::new(200.0, 50.0), restitution: e, mass_model: model, gravity: DVec2::ZERO };
+        let spec = StepSpec { dt, half: DVec2::new(200.0, 50.0), restitution: e, mass_model: model, gravity: DVec2::ZERO, rest_speed: 0.0 };
         let energy = |c: &[Circle], v: &[DVec2]| -> f64 {
             c.iter().zip(v).map(|(c, v)| 0.5 * model.mass(c.radius) * v.length_squared()).sum()
         };
@@ -307,8 +307,9 @@ proptest! {
         let mut any_cut_short = false;
         for _ in 0..20 {
             let before = energy(&circles, &velocities);
-            timeline.predict(&circles, &velocities, spec);
-            timeline.run(&mut circles, &mut velocities, spec, |_| {});
+            let mut held = vec![false; circles.len()];
+            timeline.predict(&circles, &velocities, &held, spec);
+            timeline.run(&mut circles, &mut velocities, &mut held, spec, |_| {});
             let after = energy(&circles, &velocities);
             prop_assert!(all_finite(&velocities));
             prop_assert!(after <= before * (1.0 + 1e-9) + 1e-9, "energy grew {before} -> {after}");

@@ -58,7 +58,8 @@ impl Hit {
     }
 
     /// The wall hits of a containment of ball `ball` (of `mass`) at `time` into the step, in
-    /// the arena `[-half, half]`.
+    /// the arena `[-half, half]`; a resting stop is not a hit (see
+    /// [`Contained::resting_impulse`]).
     pub fn walls_of(
         ball: u32,
         contained: &Contained,
@@ -72,6 +73,7 @@ impl Hit {
             .hits
             .into_iter()
             .flatten()
+            .filter(|hit| !hit.resting)
             .map(move |hit| Hit::Wall {
                 ball,
                 wall: hit.wall,
@@ -101,6 +103,9 @@ pub struct StepLog {
     /// A continuous step stopped handling impacts for some ball (see
     /// [`MAX_HITS_PER_BALL`](super::continuous::MAX_HITS_PER_BALL)).
     pub cut_short: bool,
+    /// The walls' impulse on resting balls (stops, the resting solver's contacts, sleeping
+    /// balls' weight): no hits, but part of the pressure. Mass x pixels per second.
+    pub resting_wall_impulse: f64,
 }
 
 /// The last step's contact points, for the overlay and the bench.
@@ -162,6 +167,7 @@ pub fn report_step(
             }
         }
     }
+    stats.wall_impulse += std::mem::take(&mut log.resting_wall_impulse);
     if std::mem::take(&mut log.cut_short) {
         stats.cut_short_steps += 1;
     }

@@ -1,8 +1,10 @@
 //! The continuous mode: each fixed step as a timeline of impacts, handled in time order, so
 //! nothing tunnels or overlaps and, with restitution 1, energy is kept to rounding.
 //!
-//! The movement stage only damps velocities, so every ball's path over the step is a parabola
-//! under gravity (a straight segment without): exact free flight. All balls feel the same
+//! The movement stage only damps velocities, so every free ball's path over the step is a
+//! parabola under gravity (a straight segment without): exact free flight. Resting and
+//! sleeping balls hold still on the timeline until an impact sets them flying; impacts
+//! slower than the resting speed do not bounce (`timeline.rs` says what they do). All balls feel the same
 //! gravity, so two balls approach in a straight line and their time of impact is the
 //! straight-line one; a wall's is the first root of a quadratic. Then:
 //!
@@ -39,7 +41,12 @@ pub fn predict_impacts(
     mut timeline: ResMut<Timeline>,
 ) {
     let spec = StepSpec::new(&params, clock.dt);
-    timeline.predict(&snapshot.circles, &snapshot.velocities, spec);
+    timeline.predict(
+        &snapshot.circles,
+        &snapshot.velocities,
+        &snapshot.held,
+        spec,
+    );
 }
 
 /// Stage 3: the impacts in time order; the balls written back at the end of the step.
@@ -56,15 +63,17 @@ pub fn run_timeline(
         entities,
         circles,
         velocities,
+        held,
     } = &mut *snapshot;
     let log = &mut *log;
-    timeline.run(circles, velocities, spec, |hit| {
+    timeline.run(circles, velocities, held, spec, |hit| {
         if let Hit::Ball { point, normal, .. } = hit {
             log.contacts.push(ContactPoint { point, normal });
         }
         log.hits.push(hit);
     });
     log.cut_short = timeline.cut_short;
+    log.resting_wall_impulse += timeline.resting_wall_impulse;
     write_back(entities, &mut balls, |index| {
         Some((circles[index].center, velocities[index]))
     });

@@ -1,16 +1,22 @@
-//! Stage 2, continuous: predicting impacts. At the start of the step the circles swept along
-//! each ball's straight path go into the grid; their AABBs and distances cut the candidate
-//! pairs, and the exact time of impact gives each approaching pair's moment of contact within
-//! the step, and each ball's first wall contact. During the timeline, a ball redirected by an
-//! impact is predicted for again against the balls near the rest of its path.
+//! Stage 2, continuous: predicting impacts. At the start of the step every ball goes on the
+//! timeline as a `Mover` (held balls still), and the circles swept along each one's path go
+//! into the grid; their AABBs and distances cut the candidate pairs, and the exact time of
+//! impact gives each approaching pair's moment of contact within the step, and each ball's
+//! first wall contact. During the timeline, a ball redirected by an impact is predicted for
+//! again against the balls near the rest of its path.
+//!
+//! Two balls with the same acceleration (both in free flight, or both still) close in a
+//! straight line: [`approach_time`]. Otherwise (a falling ball and a still one, or one
+//! sliding along a wall) the relative path is a parabola: [`time_to_touch`].
 
 use std::cmp::Reverse;
 
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Prediction, approach_time, swept_circle};
-use super::state::{MAX_HITS_PER_BALL, StepSpec, Timeline};
+use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circles_touch, overlapping};
+use crate::sim::geometry::flight::time_to_touch;
 use crate::sim::geometry::pairs::search_in_bands;
 use crate::sim::geometry::wall::wall_time_of_impact;
 
@@ -21,19 +27,27 @@ const SWEPT_MARGIN: f64 = 1e-6;
 impl Timeline {
     /// The collision stage's part: every impact of the coming step that the balls' current
     /// paths lead to. `circles` are the balls at the start of the step, `velocities` their
-    /// velocities for the whole step.
-    pub fn predict(&mut self, circles: &[Circle], velocities: &[DVec2], spec: StepSpec) {
+    /// velocities for the whole step; `held` balls hold still.
+    pub fn predict(
+        &mut self,
+        circles: &[Circle],
+        velocities: &[DVec2],
+        held: &[bool],
+        spec: StepSpec,
+    ) {
         let dt = spec.dt;
+        self.movers.clear();
+        self.movers
+            .extend(circles.iter().zip(velocities).zip(held).map(
+                |((circle, velocity), &still)| Mover::new(*circle, *velocity, spec.gravity, still),
+            ));
         self.swept.clear();
-        self.swept.extend(
-            circles
-                .iter()
-                .zip(velocities)
-                .map(|(circle, velocity)| swept_circle(*circle, *velocity, spec.gravity, dt)),
-        );
+        self.swept
+            .extend(self.movers.iter().map(|mover| swept_by(mover, dt)));
         self.grid_reach = self.swept.iter().map(|s| s.radius).fold(0.0, f64::max);
         self.grid.rebuild(&self.swept);
         self.predictions.clear();
+        let movers = &self.movers;
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
             grid.for_each_candidate_pair_in_rows(rows, |i, j, swept_i, swept_j| {
                 // The swept circles bound the paths: if they do not touch, the balls cannot.
@@ -41,25 +55,19 @@ impl Timeline {
                     return;
                 }
                 let (a, b) = (i.min(j), i.max(j));
-                let (ca, cb) = (circles[a as usize], circles[b as usize]);
-                let (va, vb) = (velocities[a as usize], velocities[b as usize]);
-                if overlapping(ca, cb) {
+                if overlapping(circles[a as usize], circles[b as usize]) {
                     found.push(Prediction::Overlap(a, b));
                 }
-                if let Some(time) = approach_time(ca, va, cb, vb).filter(|&t| t <= dt) {
+                let (ma, mb) = (&movers[a as usize], &movers[b as usize]);
+                if let Some(time) = pair_time(ma, mb, 0.0, dt) {
                     let impact = Impact::between(time, (a as usize, 0), (b as usize, 0));
                     found.push(Prediction::Impact(impact));
                 }
             });
         });
-        for (index, (circle, velocity)) in circles.iter().zip(velocities).enumerate() {
-            if let Some((time, wall)) = wall_time_of_impact(
-                circle.center,
-                *velocity,
-                circle.radius,
-                spec.half,
-                spec.gravity,
-            ) && time <= dt
+        for (index, mover) in self.movers.iter().enumerate() {
+            if let Some((time, wall)) = wall_time(mover, spec)
+                && time <= dt
             {
                 let impact = Impact::with_wall(time, index, 0, wall);
                 self.predictions.push(Prediction::Impact(impact));
@@ -75,15 +83,9 @@ impl Timeline {
             self.cut_short = true;
             return;
         }
-        let (circle, velocity) = (mover.circle(), mover.velocity);
         let queue = &mut self.queue;
-        if let Some((time, wall)) = wall_time_of_impact(
-            circle.center,
-            velocity,
-            circle.radius,
-            spec.half,
-            spec.gravity,
-        ) && now + time <= spec.dt
+        if let Some((time, wall)) = wall_time(&mover, spec)
+            && now + time <= spec.dt
         {
             queue.push(Reverse(Impact::with_wall(
                 now + time,
@@ -93,7 +95,7 @@ impl Timeline {
             )));
         }
         let rest = spec.dt - now;
-        let mut swept = swept_circle(circle, velocity, spec.gravity, rest);
+        let mut swept = swept_by(&mover, rest);
         swept.radius += SWEPT_MARGIN;
         self.rerouted.insert(
             self.grid.cell_index(swept.center),
@@ -108,13 +110,7 @@ impl Timeline {
                 return;
             }
             let other_mover = &movers[other_index];
-            let other_circle =
-                Circle::new(other_mover.center_at(now, spec.gravity), other_mover.radius);
-            let other_velocity = other_mover.velocity_at(now, spec.gravity);
-            let Some(time) = approach_time(circle, velocity, other_circle, other_velocity)
-                .map(|t| now + t)
-                .filter(|&t| t <= spec.dt)
-            else {
+            let Some(time) = pair_time(&mover, other_mover, now, spec.dt) else {
                 return;
             };
             queue.push(Reverse(Impact::between(
@@ -148,4 +144,52 @@ impl Timeline {
                 });
             });
     }
+}
+
+/// The circle `mover` sweeps over the next `seconds`.
+fn swept_by(mover: &Mover, seconds: f64) -> Circle {
+    swept_circle(
+        mover.circle(),
+        mover.moving_velocity(),
+        mover.accel,
+        seconds,
+    )
+}
+
+/// When, at most `end` seconds into the step, the paths of `a` and `b` from `now` on first
+/// bring them into contact while closing.
+pub(super) fn pair_time(a: &Mover, b: &Mover, now: f64, end: f64) -> Option<f64> {
+    let (center_a, center_b) = (a.center_at(now), b.center_at(now));
+    let (velocity_a, velocity_b) = (a.velocity_at(now), b.velocity_at(now));
+    let time = if a.accel == b.accel {
+        approach_time(
+            Circle::new(center_a, a.radius),
+            velocity_a,
+            Circle::new(center_b, b.radius),
+            velocity_b,
+        )
+    } else {
+        time_to_touch(
+            center_b - center_a,
+            velocity_b - velocity_a,
+            b.accel - a.accel,
+            a.radius + b.radius,
+            end - now,
+        )
+    };
+    time.map(|t| now + t).filter(|&t| t <= end)
+}
+
+/// When a moving `mover` first meets a wall, from its clock on; a still one meets none.
+fn wall_time(mover: &Mover, spec: StepSpec) -> Option<(f64, crate::sim::geometry::Wall)> {
+    if mover.still {
+        return None;
+    }
+    wall_time_of_impact(
+        mover.center,
+        mover.velocity,
+        mover.radius,
+        spec.half,
+        mover.accel,
+    )
 }

@@ -15,6 +15,7 @@ use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::IndexedContact;
 use crate::sim::params::{MassModel, SimParams};
+use crate::sim::resting::rest_speed;
 
 /// A ball takes at most this many hits in one step. Only an inelastic collapse (a pile
 /// pressed together by gravity, restitution below 1) comes near it; the step then ends for
@@ -32,8 +33,12 @@ pub struct StepSpec {
     pub half: DVec2,
     pub restitution: f64,
     pub mass_model: MassModel,
-    /// Pixels per second squared, the same for every ball: each one's path is a parabola.
+    /// Pixels per second squared, the same for every ball in free flight: each one's path
+    /// is a parabola.
     pub gravity: DVec2,
+    /// Impacts closing slower than this, pixels per second, do not bounce: the resting rule
+    /// ([`rest_speed`](crate::sim::resting::rest_speed)).
+    pub rest_speed: f64,
 }
 
 impl StepSpec {
@@ -44,42 +49,87 @@ impl StepSpec {
             restitution: params.restitution,
             mass_model: params.mass_model,
             gravity: params.gravity,
+            rest_speed: rest_speed(params, dt),
         }
     }
 }
 
 /// A ball on the step's timeline: where it is `clock` seconds into the step, and how many hits
 /// it has taken.
+///
+/// A ball in free flight accelerates at gravity. One that stopped against a wall slides
+/// along it, with gravity's push into the wall taken away; one that is `still` (held by the
+/// resting stage, or stopped on a ball that holds still) does not move at all until a hit
+/// sets it flying: its `velocity` is then only what it will have at the end of the step.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Mover {
     pub center: DVec2,
     pub velocity: DVec2,
+    /// Pixels per second squared.
+    pub accel: DVec2,
     pub radius: f64,
     pub clock: f64,
     pub hits: u32,
+    pub still: bool,
 }
 
 impl Mover {
+    pub fn new(circle: Circle, velocity: DVec2, gravity: DVec2, still: bool) -> Self {
+        Self {
+            center: circle.center,
+            velocity,
+            accel: if still { DVec2::ZERO } else { gravity },
+            radius: circle.radius,
+            clock: 0.0,
+            hits: 0,
+            still,
+        }
+    }
+
     pub fn circle(&self) -> Circle {
         Circle::new(self.center, self.radius)
     }
 
-    /// Where the ball is `time` seconds into the step, in free flight under `gravity`.
+    /// The velocity it moves at now: zero while still.
     #[inline]
-    pub fn center_at(&self, time: f64, gravity: DVec2) -> DVec2 {
-        position_after(self.center, self.velocity, gravity, time - self.clock)
+    pub fn moving_velocity(&self) -> DVec2 {
+        if self.still {
+            DVec2::ZERO
+        } else {
+            self.velocity
+        }
     }
 
-    /// Its velocity then.
+    /// Where the ball is `time` seconds into the step.
     #[inline]
-    pub fn velocity_at(&self, time: f64, gravity: DVec2) -> DVec2 {
-        velocity_after(self.velocity, gravity, time - self.clock)
+    pub fn center_at(&self, time: f64) -> DVec2 {
+        position_after(
+            self.center,
+            self.moving_velocity(),
+            self.accel,
+            time - self.clock,
+        )
     }
 
-    pub fn advance(&mut self, time: f64, gravity: DVec2) {
-        self.center = self.center_at(time, gravity);
-        self.velocity = self.velocity_at(time, gravity);
+    /// The velocity it moves at then.
+    #[inline]
+    pub fn velocity_at(&self, time: f64) -> DVec2 {
+        velocity_after(self.moving_velocity(), self.accel, time - self.clock)
+    }
+
+    pub fn advance(&mut self, time: f64) {
+        if !self.still {
+            self.center = self.center_at(time);
+            self.velocity = self.velocity_at(time);
+        }
         self.clock = time;
+    }
+
+    /// Sets it flying from now at `velocity` under `gravity`.
+    pub fn fly(&mut self, velocity: DVec2, gravity: DVec2) {
+        self.velocity = velocity;
+        self.accel = gravity;
+        self.still = false;
     }
 }
 
@@ -102,4 +152,7 @@ pub struct Timeline {
     pub(super) fallback: Vec<IndexedContact>,
     /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
     pub cut_short: bool,
+    /// The walls' impulse on balls that stopped against them by the resting rule in the last
+    /// run, mass x pixels per second: pressure, not hits.
+    pub resting_wall_impulse: f64,
 }

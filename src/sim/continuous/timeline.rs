@@ -6,6 +6,12 @@
 //! [`Timeline::run`] reads as those steps. Balls move lazily: each `Mover` remembers where it
 //! was at the moment of its last hit. An impact remembers how many hits each of its balls had
 //! when it was predicted; if either has been hit since, the prediction is stale and skipped.
+//!
+//! The resting rule: an impact closing slower than the resting speed does not bounce. A ball
+//! stopping against a wall slides along it, gravity's push into the wall taken away (the
+//! wall carries it: the impulse counts towards the pressure, not as a hit); one stopping on a
+//! ball that holds still holds still itself until the step ends; two flying balls meeting
+//! that slowly move on together (restitution 0). None of these is a hit.
 
 use std::cmp::Reverse;
 
@@ -16,23 +22,25 @@ use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
 use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
 use crate::sim::geometry::pairs::find_contacts;
-use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_in_arena};
+use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_at_rest};
 use crate::sim::params::BroadPhase;
 use crate::sim::report::Hit;
 
 impl Timeline {
     /// The response stage's part: handles the predicted impacts in time order, predicting
-    /// anew for every ball hit, then moves every ball to the end of the step. `circles` and
-    /// `velocities` must be what [`predict`](Self::predict) was given; they are updated in
-    /// place. Calls `on_hit` for each hit, in the order handled.
+    /// anew for every ball hit, then moves every ball to the end of the step. `circles`,
+    /// `velocities` and `held` must be what [`predict`](Self::predict) was given; they are
+    /// updated in place (a held ball a hit sets flying is no longer held). Calls `on_hit`
+    /// for each hit, in the order handled.
     pub fn run(
         &mut self,
         circles: &mut [Circle],
         velocities: &mut [DVec2],
+        held: &mut [bool],
         spec: StepSpec,
         mut on_hit: impl FnMut(Hit),
     ) {
-        self.start(circles, velocities);
+        self.start();
         while let Some(Reverse(impact)) = self.queue.pop() {
             if !self.is_current(&impact) {
                 continue;
@@ -42,29 +50,17 @@ impl Timeline {
                 None => self.collide(impact, spec, &mut on_hit),
             }
         }
-        self.move_to_the_end(circles, velocities, spec);
+        self.move_to_the_end(circles, velocities, held, spec);
         if self.cut_short {
-            self.resolve_what_was_cut_short(circles, velocities, spec, &mut on_hit);
+            self.resolve_what_was_cut_short(circles, velocities, held, spec, &mut on_hit);
         }
-        self.push_apart_overlaps(circles, spec);
-        contain_at_the_end(circles, velocities, spec, &mut on_hit);
+        self.push_apart_overlaps(circles, held, spec);
+        self.resting_wall_impulse += contain_at_the_end(circles, velocities, spec, &mut on_hit);
     }
 
-    /// Every ball at the start of the step, no hits yet; the predictions queued.
-    fn start(&mut self, circles: &[Circle], velocities: &[DVec2]) {
-        self.movers.clear();
-        self.movers.extend(
-            circles
-                .iter()
-                .zip(velocities.iter())
-                .map(|(circle, velocity)| Mover {
-                    center: circle.center,
-                    velocity: *velocity,
-                    radius: circle.radius,
-                    clock: 0.0,
-                    hits: 0,
-                }),
-        );
+    /// Every ball at the start of the step (placed by [`predict`](Self::predict)), no hits
+    /// yet; the predictions queued.
+    fn start(&mut self) {
         self.rerouted.reset(self.grid.cell_count());
         self.queue.clear();
         self.overlapping.clear();
@@ -75,6 +71,7 @@ impl Timeline {
             }
         }
         self.cut_short = false;
+        self.resting_wall_impulse = 0.0;
     }
 
     /// Whether `impact` still holds: neither ball has been hit since it was predicted, and
@@ -95,7 +92,8 @@ impl Timeline {
         true
     }
 
-    /// Ball `impact.a` reaches `wall`: it bounces if it still moves into it.
+    /// Ball `impact.a` reaches `wall`: it bounces if it still moves into it, or stops
+    /// against it if slower than the resting speed.
     fn bounce_off(
         &mut self,
         impact: Impact,
@@ -105,8 +103,16 @@ impl Timeline {
     ) {
         let (a, now) = (impact.a as usize, impact.time);
         let mover = &mut self.movers[a];
-        mover.advance(now, spec.gravity);
+        mover.advance(now);
         let mass = spec.mass_model.mass(mover.radius);
+        if mover.velocity.dot(wall.outward_normal()) < spec.rest_speed {
+            if let Some(impulse) = stop_against_wall(mover, wall, spec, now) {
+                self.resting_wall_impulse += mass * impulse;
+                mover.hits += 1;
+                self.predict_for(a, now, spec);
+            }
+            return;
+        }
         let Some(bounce) = bounce_off_wall(
             mover.circle(),
             &mut mover.velocity,
@@ -118,6 +124,7 @@ impl Timeline {
             return;
         };
         mover.center = bounce.center;
+        mover.accel = spec.gravity;
         mover.hits += 1;
         on_hit(Hit::Wall {
             ball: impact.a,
@@ -131,17 +138,23 @@ impl Timeline {
     }
 
     /// Balls `impact.a` and `impact.other` meet: they exchange momentum along the line of
-    /// centres if they still approach.
+    /// centres if they still approach, or come to rest on each other if slower than the
+    /// resting speed.
     fn collide(&mut self, impact: Impact, spec: StepSpec, on_hit: &mut impl FnMut(Hit)) {
         let (a, b, now) = (impact.a as usize, impact.other as usize, impact.time);
-        self.movers[a].advance(now, spec.gravity);
-        self.movers[b].advance(now, spec.gravity);
+        self.movers[a].advance(now);
+        self.movers[b].advance(now);
         let (ma, mb) = (self.movers[a], self.movers[b]);
         let offset = mb.center - ma.center;
         let normal = contact_normal(offset, offset.length());
+        let (velocity_a, velocity_b) = (ma.moving_velocity(), mb.moving_velocity());
+        if (velocity_a - velocity_b).dot(normal) < spec.rest_speed {
+            self.come_to_rest(a, b, normal, now, spec);
+            return;
+        }
         let Some(exchange) = normal_exchange(
-            ma.velocity,
-            mb.velocity,
+            velocity_a,
+            velocity_b,
             spec.mass_model.inverse_mass(ma.radius),
             spec.mass_model.inverse_mass(mb.radius),
             normal,
@@ -149,8 +162,8 @@ impl Timeline {
         ) else {
             return;
         };
-        self.movers[a].velocity = exchange.velocity_a;
-        self.movers[b].velocity = exchange.velocity_b;
+        self.movers[a].fly(exchange.velocity_a, spec.gravity);
+        self.movers[b].fly(exchange.velocity_b, spec.gravity);
         self.movers[a].hits += 1;
         self.movers[b].hits += 1;
         on_hit(Hit::Ball {
@@ -166,20 +179,64 @@ impl Timeline {
         self.predict_for(b, now, spec);
     }
 
+    /// Balls `a` and `b` meet slower than the resting speed (`normal` from `a` to `b`): a
+    /// ball meeting one that holds still stops on it and holds still too; two moving balls
+    /// lose their closing speed (restitution 0) and fly on.
+    fn come_to_rest(&mut self, a: usize, b: usize, normal: DVec2, now: f64, spec: StepSpec) {
+        let (ma, mb) = (self.movers[a], self.movers[b]);
+        match (ma.still, mb.still) {
+            (true, true) => {}
+            (false, true) => self.stop_on_support(a, normal, now, spec),
+            (true, false) => self.stop_on_support(b, -normal, now, spec),
+            (false, false) => {
+                let Some(exchange) = normal_exchange(
+                    ma.velocity,
+                    mb.velocity,
+                    spec.mass_model.inverse_mass(ma.radius),
+                    spec.mass_model.inverse_mass(mb.radius),
+                    normal,
+                    0.0,
+                ) else {
+                    return;
+                };
+                self.movers[a].velocity = exchange.velocity_a;
+                self.movers[b].velocity = exchange.velocity_b;
+                self.movers[a].hits += 1;
+                self.movers[b].hits += 1;
+                self.predict_for(a, now, spec);
+                self.predict_for(b, now, spec);
+            }
+        }
+    }
+
+    /// Ball `index` stops on a support that holds still (towards `into`, unit): it keeps only
+    /// its velocity along the support's surface, for the end of the step, and holds still.
+    fn stop_on_support(&mut self, index: usize, into: DVec2, now: f64, spec: StepSpec) {
+        let mover = &mut self.movers[index];
+        mover.velocity -= into * mover.velocity.dot(into).max(0.0);
+        mover.still = true;
+        mover.accel = DVec2::ZERO;
+        mover.hits += 1;
+        self.predict_for(index, now, spec);
+    }
+
     /// Every ball where the end of the step finds it.
     fn move_to_the_end(
         &mut self,
         circles: &mut [Circle],
         velocities: &mut [DVec2],
+        held: &mut [bool],
         spec: StepSpec,
     ) {
-        for ((circle, velocity), mover) in circles
+        for (((circle, velocity), held), mover) in circles
             .iter_mut()
             .zip(velocities.iter_mut())
+            .zip(held.iter_mut())
             .zip(&mut self.movers)
         {
-            mover.advance(spec.dt, spec.gravity);
+            mover.advance(spec.dt);
             (circle.center, *velocity) = (mover.center, mover.velocity);
+            *held &= mover.still;
         }
     }
 
@@ -188,6 +245,7 @@ impl Timeline {
         &mut self,
         circles: &mut [Circle],
         velocities: &mut [DVec2],
+        held: &mut [bool],
         spec: StepSpec,
         on_hit: &mut impl FnMut(Hit),
     ) {
@@ -203,57 +261,92 @@ impl Timeline {
             pairs,
             circles,
             velocities,
-            spec.mass_model,
-            spec.restitution,
+            held,
+            (spec.mass_model, spec.restitution, spec.rest_speed),
             |a, b, geometry, exchange| on_hit(Hit::ball(a, b, spec.dt, geometry, exchange)),
         );
     }
 
     /// Pushes apart, shared by inverse mass, the pairs that overlapped at the start of the
-    /// step and still do.
-    fn push_apart_overlaps(&self, circles: &mut [Circle], spec: StepSpec) {
+    /// step and still do; a held ball does not move, and two held ones are the resting
+    /// stage's.
+    fn push_apart_overlaps(&self, circles: &mut [Circle], held: &[bool], spec: StepSpec) {
         for &(a, b) in &self.overlapping {
             let (a, b) = (a as usize, b as usize);
+            if held[a] && held[b] {
+                continue;
+            }
             let Some(geometry) = circle_contact(circles[a], circles[b]) else {
                 continue;
             };
-            let inverse_masses = (
-                spec.mass_model.inverse_mass(circles[a].radius),
-                spec.mass_model.inverse_mass(circles[b].radius),
-            );
+            let inverse_mass = |index: usize| {
+                if held[index] {
+                    0.0
+                } else {
+                    spec.mass_model.inverse_mass(circles[index].radius)
+                }
+            };
+            let inverse_masses = (inverse_mass(a), inverse_mass(b));
             separate(circles, (a, b), geometry, inverse_masses);
         }
     }
 }
 
+/// Ball `mover`, at a wall and closing slower than the resting speed, stops against it: its
+/// velocity into the wall goes, and so does gravity's push into it for the rest of the step,
+/// so it slides along the wall. Returns the impulse per unit mass the wall gives it over the
+/// step (the stop and the push it carries), or `None` if it neither moves nor is pushed into
+/// the wall.
+fn stop_against_wall(mover: &mut Mover, wall: Wall, spec: StepSpec, now: f64) -> Option<f64> {
+    let outward = wall.outward_normal();
+    let (speed_in, pushed_in) = (
+        mover.velocity.dot(outward).max(0.0),
+        mover.accel.dot(outward).max(0.0),
+    );
+    if speed_in == 0.0 && pushed_in == 0.0 {
+        return None;
+    }
+    mover.velocity -= outward * speed_in;
+    mover.accel -= outward * pushed_in;
+    let axis = usize::from(outward.y != 0.0);
+    mover.center[axis] = outward[axis] * (spec.half[axis] - mover.radius);
+    Some(speed_in + pushed_in * (spec.dt - now))
+}
+
 /// Rounding can leave a ball a hair past a wall, and pushing overlaps apart can push one into
-/// it: the same containment as the discrete mode puts it back.
+/// it: the same containment as the discrete mode puts it back. Returns the walls' impulse on
+/// the balls it stopped there by the resting rule.
 fn contain_at_the_end(
     circles: &mut [Circle],
     velocities: &mut [DVec2],
     spec: StepSpec,
     on_hit: &mut impl FnMut(Hit),
-) {
+) -> f64 {
+    let mut resting_impulse = 0.0;
     for (index, (circle, velocity)) in circles.iter_mut().zip(velocities.iter_mut()).enumerate() {
-        let contained = contain_in_arena(
+        let contained = contain_at_rest(
             circle.center,
             *velocity,
             circle.radius,
             spec.half,
             spec.restitution,
+            spec.rest_speed,
         );
         (circle.center, *velocity) = (contained.position, contained.velocity);
+        let mass = spec.mass_model.mass(circle.radius);
+        resting_impulse += contained.resting_impulse(mass);
         for hit in Hit::walls_of(
             index as u32,
             &contained,
             spec.dt,
             spec.half,
             spec.restitution,
-            spec.mass_model.mass(circle.radius),
+            mass,
         ) {
             on_hit(hit);
         }
     }
+    resting_impulse
 }
 
 #[cfg(test)]
@@ -269,6 +362,7 @@ mod tests {
             restitution: 1.0,
             mass_model: MassModel::Radius,
             gravity: DVec2::ZERO,
+            rest_speed: 0.0,
         };
         let mut circles = vec![
             Circle::new(DVec2::new(-100.0, 0.0), 5.0),
@@ -283,9 +377,12 @@ mod tests {
         };
         let before = energy(&velocities, &circles);
         let mut timeline = Timeline::default();
-        timeline.predict(&circles, &velocities, spec);
+        let mut held = vec![false; 2];
+        timeline.predict(&circles, &velocities, &held, spec);
         let mut hits = Vec::new();
-        timeline.run(&mut circles, &mut velocities, spec, |hit| hits.push(hit));
+        timeline.run(&mut circles, &mut velocities, &mut held, spec, |hit| {
+            hits.push(hit)
+        });
         assert_eq!(hits.len(), 1);
         let Hit::Ball { time, point, .. } = hits[0] else {
             panic!("a ball hit")

@@ -6,7 +6,8 @@
 //! reading [`Contacts`] in their stable order (Gauss–Seidel: each contact sees the velocities
 //! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then writes the
 //! balls that changed back to their components in one pass. Records each exchange and wall
-//! hit in the [`StepLog`].
+//! hit in the [`StepLog`]. The resting rule applies to pairs and walls alike (see
+//! [`resolve_overlaps`]); pairs of resting balls are the resting stage's.
 
 use bevy::prelude::*;
 
@@ -14,9 +15,10 @@ use super::detect::Contacts;
 use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
 use crate::sim::clock::SimClock;
 use crate::sim::geometry::impulse::resolve_overlaps;
-use crate::sim::geometry::wall::contain_in_arena;
+use crate::sim::geometry::wall::contain_at_rest;
 use crate::sim::params::SimParams;
 use crate::sim::report::{Hit, StepLog};
+use crate::sim::resting::rest_speed;
 
 pub fn resolve_contacts(
     clock: Res<SimClock>,
@@ -36,6 +38,7 @@ pub fn resolve_contacts(
         entities,
         circles,
         velocities,
+        held,
     } = &mut *snapshot;
     in_contact.clear();
     in_contact.resize(entities.len(), false);
@@ -47,38 +50,46 @@ pub fn resolve_contacts(
     }
     let pairs = contacts.0.iter().map(|contact| (contact.a, contact.b));
     let (mass_model, restitution) = (params.mass_model, params.restitution);
+    let rest_speed = rest_speed(&params, clock.dt);
+    let log = &mut *log;
     let hits = &mut log.hits;
     resolve_overlaps(
         pairs,
         circles,
         velocities,
-        mass_model,
-        restitution,
+        held,
+        (mass_model, restitution, rest_speed),
         |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange)),
     );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
     // the movement stage kept every ball inside, so only they need the walls again, and only
     // they are written back.
     let half = params.half_extents();
+    let resting_wall_impulse = &mut log.resting_wall_impulse;
     let mut settle = |index: usize| {
         let circle = circles[index];
-        let contained = contain_in_arena(
+        let contained = contain_at_rest(
             circle.center,
             velocities[index],
             circle.radius,
             half,
             restitution,
+            rest_speed,
         );
         if contained.hits != [None, None] {
+            let mass = mass_model.mass(circle.radius);
+            *resting_wall_impulse += contained.resting_impulse(mass);
             hits.extend(Hit::walls_of(
                 index as u32,
                 &contained,
                 step_end,
                 half,
                 restitution,
-                mass_model.mass(circle.radius),
+                mass,
             ));
         }
+        // The resting stage reads the snapshot after this stage.
+        (circles[index].center, velocities[index]) = (contained.position, contained.velocity);
         (contained.position, contained.velocity)
     };
     write_back(entities, &mut balls, |index| {

@@ -87,33 +87,52 @@ pub fn separate(
 /// still touches where the earlier pairs left it, the exchange along the normal (if the balls
 /// approach; `on_exchange` hears of it) and then separation shared by inverse mass. Both
 /// collision modes use it: discrete for every contact, continuous for a step it cut short.
+///
+/// The resting rule: a pair closing slower than `rest_speed` does not bounce (restitution 0)
+/// and is not an exchange anyone hears of; a `held` ball (resting or asleep) then counts as
+/// immovable, for the exchange and the separation alike. A faster hit on a held ball is an
+/// ordinary exchange, and sets it moving: its `held` is cleared. Pairs of held balls are the
+/// resting solver's, and skipped.
 pub fn resolve_overlaps(
     pairs: impl IntoIterator<Item = (u32, u32)>,
     circles: &mut [Circle],
     velocities: &mut [DVec2],
-    mass_model: MassModel,
-    restitution: f64,
+    held: &mut [bool],
+    (mass_model, restitution, rest_speed): (MassModel, f64, f64),
     mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
     for (a, b) in pairs {
         let (ia, ib) = (a as usize, b as usize);
+        if held[ia] && held[ib] {
+            continue;
+        }
         // Earlier pairs may have moved either ball: work from where they are now.
         let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
             continue;
         };
-        let inverse_mass_a = mass_model.inverse_mass(circles[ia].radius);
-        let inverse_mass_b = mass_model.inverse_mass(circles[ib].radius);
+        let resting = (velocities[ia] - velocities[ib]).dot(geometry.normal) < rest_speed;
+        let inverse_mass = |index: usize| {
+            if resting && held[index] {
+                0.0
+            } else {
+                mass_model.inverse_mass(circles[index].radius)
+            }
+        };
+        let (inverse_mass_a, inverse_mass_b) = (inverse_mass(ia), inverse_mass(ib));
         if let Some(exchange) = normal_exchange(
             velocities[ia],
             velocities[ib],
             inverse_mass_a,
             inverse_mass_b,
             geometry.normal,
-            restitution,
+            if resting { 0.0 } else { restitution },
         ) {
             velocities[ia] = exchange.velocity_a;
             velocities[ib] = exchange.velocity_b;
-            on_exchange(a, b, geometry, exchange);
+            if !resting {
+                (held[ia], held[ib]) = (false, false);
+                on_exchange(a, b, geometry, exchange);
+            }
         }
         separate(
             circles,

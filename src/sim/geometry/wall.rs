@@ -41,6 +41,8 @@ pub struct WallHit {
     pub wall: Wall,
     /// Speed into the wall before the hit, pixels per second (positive).
     pub normal_speed: f64,
+    /// Slower than the resting speed: the ball stopped against the wall instead of bouncing.
+    pub resting: bool,
 }
 
 /// The outcome of [`contain_in_arena`].
@@ -52,6 +54,18 @@ pub struct Contained {
     pub hits: [Option<WallHit>; 2],
 }
 
+impl Contained {
+    /// The impulse the walls gave a ball of `mass` in its resting stops: `m·v_n` each.
+    pub fn resting_impulse(&self, mass: f64) -> f64 {
+        self.hits
+            .iter()
+            .flatten()
+            .filter(|hit| hit.resting)
+            .map(|hit| wall_impulse(mass, 0.0, hit.normal_speed))
+            .sum()
+    }
+}
+
 /// Puts a ball whose circle crosses a wall of the arena `[-half, half]` back inside.
 ///
 /// A ball moving into the wall is mirrored back by the restitution-scaled overshoot and its
@@ -59,11 +73,25 @@ pub struct Contained {
 /// by a neighbour) is only moved back to the wall. A ball wider than the arena is centred on
 /// that axis and stopped along it.
 pub fn contain_in_arena(
+    position: DVec2,
+    velocity: DVec2,
+    radius: f64,
+    half: DVec2,
+    restitution: f64,
+) -> Contained {
+    contain_at_rest(position, velocity, radius, half, restitution, 0.0)
+}
+
+/// [`contain_in_arena`] with the resting rule: a ball meeting a wall slower than
+/// `rest_speed` (pixels per second) does not bounce but stops against it (restitution 0,
+/// and its [`WallHit`] says `resting`).
+pub fn contain_at_rest(
     mut position: DVec2,
     mut velocity: DVec2,
     radius: f64,
     half: DVec2,
     restitution: f64,
+    rest_speed: f64,
 ) -> Contained {
     let mut hits = [None, None];
     for (axis, (low_wall, high_wall)) in [(Wall::Left, Wall::Right), (Wall::Bottom, Wall::Top)]
@@ -83,11 +111,14 @@ pub fn contain_in_arena(
             }
             let speed_into_wall = side * velocity[axis];
             if speed_into_wall > 0.0 {
+                let resting = speed_into_wall < rest_speed;
+                let restitution = if resting { 0.0 } else { restitution };
                 position[axis] = side * (limit - restitution * overshoot);
                 velocity[axis] = -side * restitution * speed_into_wall;
                 hits[axis] = Some(WallHit {
                     wall,
                     normal_speed: speed_into_wall,
+                    resting,
                 });
             }
             position[axis] = position[axis].clamp(-limit, limit);
@@ -212,7 +243,8 @@ mod tests {
             [
                 Some(WallHit {
                     wall: Wall::Right,
-                    normal_speed: 30.0
+                    normal_speed: 30.0,
+                    resting: false,
                 }),
                 None
             ]

@@ -1,13 +1,13 @@
 //! [`StateSummary`]: figures over the whole current state, measured on demand from the ball
-//! components: energy, momentum, temperature, the speed histogram, escapes and, when asked,
-//! the largest overlap. The headless report, the soak, the panel and the tests use the same
+//! components: energy, momentum, temperature, the speed histogram, escapes, how many balls
+//! move and sleep and, when asked, the overlaps. The headless report, the soak, the panel and the tests use the same
 //! summary.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::gas::{SPEED_BINS, SpeedHistogram};
-use crate::sim::ball::{Ball, Position, Radius, Velocity};
+use crate::sim::ball::{Ball, Position, Radius, Rest, Velocity};
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
@@ -25,6 +25,9 @@ pub fn potential_energy(mass: f64, position: DVec2, gravity: DVec2) -> f64 {
     -mass * gravity.dot(position)
 }
 
+/// A ball faster than this, pixels per second, counts as moving.
+pub const MOVING_SPEED: f64 = 1.0;
+
 /// Figures over the whole current state.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StateSummary {
@@ -36,6 +39,14 @@ pub struct StateSummary {
     /// Largest overlap between two balls, divided by the smaller radius (measured by
     /// [`measure`](Self::measure) only: it searches for pairs).
     pub max_overlap_rel: f64,
+    /// Mean of the same over the overlapping pairs (by [`measure`](Self::measure) only).
+    pub mean_overlap_rel: f64,
+    /// Balls faster than [`MOVING_SPEED`].
+    pub moving: usize,
+    /// Root mean square of the speeds, pixels per second.
+    pub rms_speed: f64,
+    /// Balls asleep (by [`measure`](Self::measure) only: it reads their [`Rest`]).
+    pub sleeping: usize,
     /// Balls whose centre lies outside the arena.
     pub escaped: usize,
     /// Ball speeds against the Maxwell–Boltzmann curve for their temperature.
@@ -73,6 +84,11 @@ impl StateSummary {
                 summary.escaped += 1;
             }
             speeds.push((mass, velocity.length()));
+            summary.moving += usize::from(velocity.length() > MOVING_SPEED);
+            summary.rms_speed += velocity.length_squared();
+        }
+        if summary.ball_count > 0 {
+            summary.rms_speed = (summary.rms_speed / summary.ball_count as f64).sqrt();
         }
         summary.speed_histogram = SpeedHistogram::measure(speeds, SPEED_BINS);
         summary
@@ -91,13 +107,21 @@ impl StateSummary {
             .iter()
             .map(|&(position, _, radius)| Circle::new(position, radius))
             .collect();
-        summary.max_overlap_rel = max_overlap_rel(&circles);
+        (summary.max_overlap_rel, summary.mean_overlap_rel) = overlaps_rel(&circles);
+        let mut rests = world.query_filtered::<&Rest, With<Ball>>();
+        summary.sleeping = rests.iter(world).filter(|rest| rest.is_asleep()).count();
         summary
     }
 }
 
 /// The largest overlap among `circles`, divided by the smaller radius of its pair.
 pub fn max_overlap_rel(circles: &[Circle]) -> f64 {
+    overlaps_rel(circles).0
+}
+
+/// The largest overlap among `circles`, and the mean over the overlapping pairs, each
+/// divided by the smaller radius of its pair.
+pub fn overlaps_rel(circles: &[Circle]) -> (f64, f64) {
     let mut contacts: Vec<IndexedContact> = Vec::new();
     find_contacts(
         circles,
@@ -105,15 +129,17 @@ pub fn max_overlap_rel(circles: &[Circle]) -> f64 {
         &mut UniformGrid::default(),
         &mut contacts,
     );
-    contacts
-        .iter()
-        .map(|c| {
-            let smaller = circles[c.a as usize]
-                .radius
-                .min(circles[c.b as usize].radius);
-            c.geometry.depth / smaller
-        })
-        .fold(0.0, f64::max)
+    let (mut largest, mut sum, mut count) = (0.0_f64, 0.0, 0_usize);
+    for contact in contacts.iter().filter(|c| c.geometry.depth > 0.0) {
+        let smaller = circles[contact.a as usize]
+            .radius
+            .min(circles[contact.b as usize].radius);
+        let overlap = contact.geometry.depth / smaller;
+        largest = largest.max(overlap);
+        sum += overlap;
+        count += 1;
+    }
+    (largest, if count == 0 { 0.0 } else { sum / count as f64 })
 }
 
 #[cfg(test)]

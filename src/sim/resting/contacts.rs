@@ -1,0 +1,216 @@
+//! The resting stage's contacts: every pair of balls, and every ball and wall, that touch
+//! within a small margin or could within the step at the speeds they have (Box2D's
+//! speculative contacts) ([`NearPairs`]), and from them the resting solver's bodies and
+//! contacts, warm-started from the impulses the same contacts carried last step.
+
+use std::collections::HashMap;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::solver::{Body, Other, RestingContact};
+use crate::sim::geometry::circle::{Circle, contact_normal};
+use crate::sim::geometry::grid::UniformGrid;
+use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::geometry::wall::Wall;
+use crate::sim::params::{BroadPhase, MassModel};
+
+/// Balls within this fraction of their radii of touching count as touching: a resting ball
+/// sinks about `|g|·dt²` (0.14 px at 500 px/s² and 60 steps a second) in a step before its
+/// contacts push back.
+pub const CONTACT_MARGIN: f64 = 0.02;
+
+/// Two balls near each other: `a < b`, places in the snapshot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NearPair {
+    pub a: u32,
+    pub b: u32,
+    /// Pixels; negative when overlapping.
+    pub gap: f64,
+    /// Unit, from `a` to `b`.
+    pub normal: DVec2,
+    /// Within the margin of touching.
+    pub touching: bool,
+}
+
+/// Whether a gap of `gap` pixels between balls (or a ball and a wall) of radii summing to
+/// `radii` counts as touching.
+fn within_margin(gap: f64, radii: f64) -> bool {
+    gap <= CONTACT_MARGIN * radii
+}
+
+/// Pairs and walls near touching, found anew each step.
+#[derive(Debug, Default)]
+pub struct NearPairs {
+    /// `(a, b, gap in pixels, unit normal from a to b)`, `a < b`, in the grid's fixed order.
+    pub pairs: Vec<NearPair>,
+    /// `(ball, wall, gap in pixels)`.
+    pub walls: Vec<(u32, Wall, f64)>,
+    /// Whether each ball touches a ball or a wall (within the margin, not speculatively).
+    pub touching: Vec<bool>,
+    /// The walls' impulse on each ball in the last solve, mass x pixels per second.
+    pub wall_impulse_of: Vec<f64>,
+    grid: UniformGrid,
+    inflated: Vec<Circle>,
+    found: Vec<IndexedContact>,
+    /// The two sides of each solver contact, for its warm start.
+    sides: Vec<(u32, Option<Wall>)>,
+}
+
+impl NearPairs {
+    /// Finds the pairs and walls near touching among `circles` moving at `velocities` in the
+    /// arena `[-half, half]`: within the margin, or within reach of a step of `dt`.
+    pub fn find(&mut self, circles: &[Circle], velocities: &[DVec2], half: DVec2, dt: f64) {
+        let reach = |circle: &Circle, velocity: &DVec2| {
+            circle.radius * CONTACT_MARGIN + velocity.length() * dt
+        };
+        self.inflated.clear();
+        self.inflated.extend(
+            circles
+                .iter()
+                .zip(velocities)
+                .map(|(c, v)| Circle::new(c.center, c.radius + reach(c, v))),
+        );
+        self.found.clear();
+        find_contacts(
+            &self.inflated,
+            BroadPhase::Grid,
+            &mut self.grid,
+            &mut self.found,
+        );
+        self.touching.clear();
+        self.touching.resize(circles.len(), false);
+        self.wall_impulse_of.clear();
+        self.wall_impulse_of.resize(circles.len(), 0.0);
+        self.pairs.clear();
+        for contact in &self.found {
+            let (a, b) = (circles[contact.a as usize], circles[contact.b as usize]);
+            let offset = b.center - a.center;
+            let distance = offset.length();
+            let gap = distance - (a.radius + b.radius);
+            let touching = within_margin(gap, a.radius + b.radius);
+            self.pairs.push(NearPair {
+                a: contact.a,
+                b: contact.b,
+                gap,
+                normal: contact_normal(offset, distance),
+                touching,
+            });
+            self.touching[contact.a as usize] |= touching;
+            self.touching[contact.b as usize] |= touching;
+        }
+        self.walls.clear();
+        for (index, (circle, velocity)) in circles.iter().zip(velocities).enumerate() {
+            for wall in Wall::ALL {
+                let outward = wall.outward_normal();
+                let axis = usize::from(outward.y != 0.0);
+                let gap = half[axis] - circle.radius - circle.center.dot(outward);
+                if gap <= reach(circle, velocity) {
+                    self.walls.push((index as u32, wall, gap));
+                    self.touching[index] |= within_margin(gap, circle.radius);
+                }
+            }
+        }
+    }
+
+    /// The solver's bodies (the `solved` balls movable, every other an anchor that stands
+    /// still for it: the mode's stages move those) and the contacts that involve a solved
+    /// ball, warm-started from `warm`.
+    pub fn solver_input(
+        &mut self,
+        circles: &[Circle],
+        velocities: &[DVec2],
+        entities: &[Entity],
+        solved: impl Fn(usize) -> bool,
+        mass_model: MassModel,
+        warm: &HashMap<(u64, u64), f64>,
+    ) -> (Vec<Body>, Vec<RestingContact>) {
+        let bodies = circles
+            .iter()
+            .zip(velocities)
+            .enumerate()
+            .map(|(index, (circle, velocity))| {
+                if solved(index) {
+                    Body::new(
+                        circle.center,
+                        *velocity,
+                        mass_model.inverse_mass(circle.radius),
+                    )
+                } else {
+                    Body::new(circle.center, DVec2::ZERO, 0.0)
+                }
+            })
+            .collect();
+        let mut contacts = Vec::new();
+        self.sides.clear();
+        for &NearPair {
+            a, b, gap, normal, ..
+        } in &self.pairs
+        {
+            if solved(a as usize) || solved(b as usize) {
+                let warm_start = warm.get(&key(entities, a, Some(b))).copied();
+                let mut contact =
+                    RestingContact::new(a, Other::Body(b), normal, gap, warm_start.unwrap_or(0.0));
+                contact.push_out = solved(a as usize) && solved(b as usize);
+                contacts.push(contact);
+                self.sides.push((a, None));
+            }
+        }
+        for &(ball, wall, gap) in &self.walls {
+            if solved(ball as usize) {
+                let warm_start = warm.get(&wall_key(entities, ball, wall)).copied();
+                contacts.push(RestingContact::new(
+                    ball,
+                    Other::Wall,
+                    wall.outward_normal(),
+                    gap,
+                    warm_start.unwrap_or(0.0),
+                ));
+                self.sides.push((ball, Some(wall)));
+            }
+        }
+        (bodies, contacts)
+    }
+
+    /// Each solved contact's impulse under its key, for the next step's warm start; and the
+    /// walls' impulse on each ball recorded in `wall_impulse_of`.
+    pub fn warm_starts<'a>(
+        &'a mut self,
+        contacts: &'a [RestingContact],
+        entities: &'a [Entity],
+    ) -> impl Iterator<Item = ((u64, u64), f64)> + 'a {
+        for (contact, &(ball, wall)) in contacts.iter().zip(&self.sides) {
+            if wall.is_some() {
+                self.wall_impulse_of[ball as usize] += contact.step_impulse;
+            }
+        }
+        contacts
+            .iter()
+            .zip(&self.sides)
+            .map(move |(contact, &(a, wall))| {
+                let key = match (contact.other, wall) {
+                    (Other::Body(b), _) => key(entities, a, Some(b)),
+                    (Other::Wall, Some(wall)) => wall_key(entities, a, wall),
+                    (Other::Wall, None) => unreachable!("a wall contact records its wall"),
+                };
+                (key, contact.impulse)
+            })
+    }
+
+    /// The walls' impulse on all balls in the last solve.
+    pub fn total_wall_impulse(&self) -> f64 {
+        self.wall_impulse_of.iter().sum()
+    }
+}
+
+/// A pair's key, the same whichever ball comes first.
+fn key(entities: &[Entity], a: u32, b: Option<u32>) -> (u64, u64) {
+    let a = entities[a as usize].to_bits();
+    let b = b.map_or(u64::MAX, |b| entities[b as usize].to_bits());
+    (a.min(b), a.max(b))
+}
+
+/// A ball and wall's key.
+fn wall_key(entities: &[Entity], ball: u32, wall: Wall) -> (u64, u64) {
+    (entities[ball as usize].to_bits(), u64::MAX - wall as u64)
+}

@@ -1,0 +1,220 @@
+//! Resting contacts and sleep, for both modes: what makes a pile under gravity hold still.
+//!
+//! **The resting rule** ([`rest_speed`]): with restitution below 1, an impact closing slower
+//! than twice the speed gravity adds in a step does not bounce (a ball resting on the floor
+//! meets it at up to one step's gain; twice leaves room for the solver's give). With
+//! restitution 1, or without gravity, every impact bounces and nothing here runs. A ball
+//! dropped with restitution `e` so bounces with apex heights shrinking by `e²` until its
+//! impact speed falls below the resting speed, then stays on the floor.
+//!
+//! **The stage** ([`rest_and_sleep`], in [`SimSystems::Resting`](super::SimSystems), after
+//! the mode's response and before the report) runs these named steps on the snapshot:
+//!
+//! 1. `wake`: every sleeping island whose ball a hit set flying, that an intent asked for, or
+//!    all of them if a parameter that shapes the motion changed (gravity, restitution, mass
+//!    model, arena, mode);
+//! 2. `find_near_pairs`: the grid's pairs within a small margin of touching, and each ball's
+//!    walls within it; an awake ball touching a sleeping island wakes it;
+//! 3. `solve`: the balls that rested through the mode's stages (held still there) take one
+//!    soft step of [`solver`] with their contacts (balls that are not resting are
+//!    immovable anchors for it); the walls' impulses count towards the pressure;
+//! 4. `classify`: a ball that touches something and is no faster than the resting speed
+//!    rests next step, any other flies;
+//! 5. `fall_asleep`: islands of touching resting balls, each ball slower than
+//!    [`SLEEP_SPEED`] for [`TIME_TO_SLEEP`] and none touching a flying ball, sleep (velocity
+//!    exactly zero) until woken; the weight they put on the walls keeps counting.
+//!
+//! The mode's stages hold resting and sleeping balls still ([`Rest::is_held`]), so a
+//! resting ball moves only here, and a sleeping one not at all: its state is bit-identical
+//! from step to step.
+
+mod contacts;
+mod sleep;
+pub mod solver;
+mod state;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+pub use self::sleep::{SLEEP_SPEED, TIME_TO_SLEEP};
+use self::solver::{SoftStep, soft_step};
+use self::state::MotionKey;
+pub use self::state::RestingState;
+use super::ball::{Ball, BallSnapshot, Position, Rest, RestState, Velocity};
+use super::clock::SimClock;
+use super::params::{SimParams, Solver};
+use super::report::StepLog;
+
+/// The resting speed is this many times the speed gravity adds in a step.
+pub const REST_SPEED_STEPS: f64 = 2.0;
+/// A ball in contact rests (the solver moves it, without sweeping its path) only while a
+/// step takes it no further than this fraction of its radius; faster, it flies (the mode's
+/// stages move it, the continuous one without tunnelling).
+pub const HOLD_REACH: f64 = 0.25;
+/// Substeps of the resting solver's soft step (Box2D's default).
+const SUBSTEPS: u32 = 4;
+/// Contact stiffness, hertz: a quarter of the substep rate at 60 steps a second, as stiff as
+/// Box2D lets a soft contact be.
+const CONTACT_HERTZ: f64 = 60.0;
+/// Box2D's contact damping ratio.
+const CONTACT_DAMPING_RATIO: f64 = 10.0;
+/// The fastest the solver pushes an overlap out, pixels per second.
+const MAX_PUSH_SPEED: f64 = 100.0;
+
+/// The resting rule's speed for a step of `dt` seconds, pixels per second: impacts closing
+/// slower than it do not bounce. Zero (every impact bounces) with restitution 1 or without
+/// gravity.
+pub fn rest_speed(params: &SimParams, dt: f64) -> f64 {
+    if params.restitution < 1.0 {
+        REST_SPEED_STEPS * params.gravity.length() * dt
+    } else {
+        0.0
+    }
+}
+
+/// The resting stage: see the module's header for its steps.
+pub fn rest_and_sleep(
+    clock: Res<SimClock>,
+    params: Res<SimParams>,
+    solver: Res<Solver>,
+    mut snapshot: ResMut<BallSnapshot>,
+    mut balls: Query<(Entity, &mut Position, &mut Velocity, &mut Rest), With<Ball>>,
+    mut state: ResMut<RestingState>,
+    mut log: ResMut<StepLog>,
+) {
+    let (dt, rest_speed) = (clock.dt, rest_speed(&params, clock.dt));
+    let state = &mut *state;
+    read_rests(&snapshot.entities, &balls, &mut state.rests);
+    let key = MotionKey {
+        gravity: params.gravity,
+        restitution: params.restitution,
+        mass_model: params.mass_model,
+        arena_size: params.arena_size,
+        mode: solver.collisions,
+    };
+    let changed = state.last_key.replace(key).is_some_and(|last| last != key);
+    let anyone_held = state.rests.iter().any(Rest::is_held);
+    if rest_speed == 0.0 && !anyone_held {
+        state.warm.clear();
+        return; // the rule is off and nobody rests: the elastic paths stay untouched
+    }
+    state.wake_all |= changed || rest_speed == 0.0;
+    let snapshot = &mut *snapshot;
+    sleep::wake(state, &snapshot.held);
+    state.near.find(
+        &snapshot.circles,
+        &snapshot.velocities,
+        params.half_extents(),
+        dt,
+    );
+    sleep::wake_touched(state);
+    let load = solve(state, snapshot, &params, dt);
+    log.resting_wall_impulse += load + state.island_load.values().sum::<f64>() * dt;
+    classify(state, snapshot, rest_speed, dt);
+    sleep::fall_asleep(state, &mut snapshot.velocities, dt);
+    state.asleep = state.rests.iter().filter(|rest| rest.is_asleep()).count();
+    write_back(snapshot, &state.rests, &mut balls);
+}
+
+/// Each ball's [`Rest`], in the snapshot's order.
+fn read_rests(
+    entities: &[Entity],
+    balls: &Query<(Entity, &mut Position, &mut Velocity, &mut Rest), With<Ball>>,
+    rests: &mut Vec<Rest>,
+) {
+    rests.clear();
+    rests.extend(
+        entities
+            .iter()
+            .map(|&entity| balls.get(entity).map_or(Rest::default(), |ball| *ball.3)),
+    );
+}
+
+/// Step 3: one soft step for the balls that rested through the step. Returns the walls'
+/// impulse on them.
+fn solve(
+    state: &mut RestingState,
+    snapshot: &mut BallSnapshot,
+    params: &SimParams,
+    dt: f64,
+) -> f64 {
+    let solved =
+        |index: usize| state.rests[index].state == RestState::Resting && snapshot.held[index];
+    let (mut bodies, mut contacts) = state.near.solver_input(
+        &snapshot.circles,
+        &snapshot.velocities,
+        &snapshot.entities,
+        solved,
+        params.mass_model,
+        &state.warm,
+    );
+    if contacts.is_empty() && bodies.iter().all(|body| body.inverse_mass == 0.0) {
+        return 0.0;
+    }
+    let step = SoftStep {
+        dt,
+        substeps: SUBSTEPS,
+        gravity: params.gravity,
+        damping: params.linear_damping,
+        hertz: CONTACT_HERTZ,
+        damping_ratio: CONTACT_DAMPING_RATIO,
+        max_push_speed: MAX_PUSH_SPEED,
+        restitution: params.restitution,
+        rest_speed: rest_speed(params, dt),
+    };
+    soft_step(&mut bodies, &mut contacts, step);
+    let warm = state
+        .near
+        .warm_starts(&contacts, &snapshot.entities)
+        .collect();
+    state.warm = warm;
+    let half = params.half_extents();
+    for (index, body) in bodies.iter().enumerate() {
+        if body.inverse_mass > 0.0 {
+            let circle = &mut snapshot.circles[index];
+            let limit = (half - DVec2::splat(circle.radius)).max(DVec2::ZERO);
+            circle.center = (body.position + body.shift).clamp(-limit, limit);
+            snapshot.velocities[index] = body.velocity;
+        }
+    }
+    state.near.total_wall_impulse()
+}
+
+/// Step 4: who rests next step. A ball touching something (a ball or a wall) and slow enough
+/// to go no further than [`HOLD_REACH`] of its radius in a step rests; any other flies.
+/// Resting balls slower than the sleep speed count time towards sleep.
+fn classify(state: &mut RestingState, snapshot: &BallSnapshot, rest_speed: f64, dt: f64) {
+    for (index, rest) in state.rests.iter_mut().enumerate() {
+        if rest.is_asleep() {
+            continue;
+        }
+        let speed = snapshot.velocities[index].length();
+        let hold_speed = rest_speed.max(HOLD_REACH * snapshot.circles[index].radius / dt);
+        let resting = rest_speed > 0.0 && state.near.touching[index] && speed <= hold_speed;
+        rest.state = if resting {
+            RestState::Resting
+        } else {
+            RestState::Free
+        };
+        rest.still_for = if resting && speed < SLEEP_SPEED {
+            rest.still_for + dt
+        } else {
+            0.0
+        };
+    }
+}
+
+/// Writes each ball's position, velocity and [`Rest`] back.
+fn write_back(
+    snapshot: &BallSnapshot,
+    rests: &[Rest],
+    balls: &mut Query<(Entity, &mut Position, &mut Velocity, &mut Rest), With<Ball>>,
+) {
+    for (index, &entity) in snapshot.entities.iter().enumerate() {
+        if let Ok((_, mut position, mut velocity, mut rest)) = balls.get_mut(entity) {
+            position.set_if_neq(Position(snapshot.circles[index].center));
+            velocity.set_if_neq(Velocity(snapshot.velocities[index]));
+            rest.set_if_neq(rests[index]);
+        }
+    }
+}
