@@ -92,7 +92,7 @@ pub fn fall_asleep(state: &mut RestingState, velocities: &mut [DVec2], dt: f64) 
         }
     }
     let mut island_of_root: Vec<Option<u32>> = vec![None; count];
-    for index in 0..count {
+    for (index, velocity) in velocities.iter_mut().enumerate() {
         if !resting(&state.rests[index]) {
             continue;
         }
@@ -105,7 +105,7 @@ pub fn fall_asleep(state: &mut RestingState, velocities: &mut [DVec2], dt: f64) 
             state.next_island
         });
         state.rests[index].state = RestState::Asleep { island };
-        velocities[index] = DVec2::ZERO;
+        *velocity = DVec2::ZERO;
         let load = state
             .near
             .wall_impulse_of
