@@ -37,6 +37,8 @@ pub struct ViewSettings {
     pub show_contacts: bool,
     pub show_velocities: bool,
     pub show_bursts: bool,
+    /// Draw sleeping balls dimmed.
+    pub dim_sleeping: bool,
 }
 
 impl Default for ViewSettings {
@@ -47,6 +49,7 @@ impl Default for ViewSettings {
             show_contacts: false,
             show_velocities: false,
             show_bursts: true,
+            dim_sleeping: true,
         }
     }
 }

@@ -20,7 +20,7 @@ use bevy::window::PrimaryWindow;
 
 use crate::app::view::{ColourMode, PlayArea, ViewSettings};
 use crate::sim::{
-    Ball, BallId, Position, PreviousPosition, Radius, RunControl, SimParams, Velocity,
+    Ball, BallId, Position, PreviousPosition, Radius, Rest, RunControl, SimParams, Velocity,
 };
 use interpolate::{drawn_position, interpolation_fraction};
 
@@ -32,6 +32,8 @@ const BACKGROUND: Color = Color::srgb(0.03, 0.035, 0.045);
 const ARENA_FLOOR: Color = Color::srgb(0.07, 0.08, 0.1);
 /// Speed shown as the hottest colour in [`ColourMode::BySpeed`], pixels per second.
 const HOT_SPEED: f64 = 600.0;
+/// How much darker a sleeping ball is drawn (with the view's toggle on), 0 to 1.
+const SLEEP_DIMMING: f32 = 0.25;
 /// Radius range spanned by the colours of [`ColourMode::BySize`], pixels.
 const SIZE_COLOUR_RANGE: (f64, f64) = (5.0, 50.0);
 
@@ -156,16 +158,22 @@ fn place_ball_sprites(
 
 fn colour_balls(
     view: Res<ViewSettings>,
-    mut balls: Query<(&BallId, &Radius, &Velocity, &mut Sprite), With<Ball>>,
+    mut balls: Query<(&BallId, &Radius, &Velocity, Ref<Rest>, &mut Sprite), With<Ball>>,
 ) {
-    // Colours by ball and by size change only with the mode; by speed, every frame.
-    if !view.is_changed() && view.colour_mode != ColourMode::BySpeed {
-        return;
-    }
+    // Colours by ball and by size change only with the mode or the sleep; by speed, every
+    // frame.
+    let every_ball = view.is_changed() || view.colour_mode == ColourMode::BySpeed;
     balls
         .par_iter_mut()
-        .for_each(|(id, radius, velocity, mut sprite)| {
-            sprite.color = colour_of(view.colour_mode, *id, radius.0, velocity.0);
+        .for_each(|(id, radius, velocity, rest, mut sprite)| {
+            if every_ball || rest.is_changed() {
+                let colour = colour_of(view.colour_mode, *id, radius.0, velocity.0);
+                sprite.color = if view.dim_sleeping && rest.is_asleep() {
+                    colour.darker(SLEEP_DIMMING)
+                } else {
+                    colour
+                };
+            }
         });
 }
 

@@ -130,6 +130,11 @@ impl BallSnapshot {
         self.held.clear();
     }
 
+    /// Whether every ball is held still: the mode's stages then have nothing to do.
+    pub fn all_held(&self) -> bool {
+        self.held.iter().all(|&held| held)
+    }
+
     pub fn push(&mut self, entity: Entity, circle: Circle, velocity: DVec2, held: bool) {
         self.entities.push(entity);
         self.circles.push(circle);

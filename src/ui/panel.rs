@@ -23,6 +23,7 @@ use crate::sim::params::{
     BALL_COUNT_SLIDER, DAMPING_SLIDER, DEFAULT_STEP_RATE, GRAVITY_SLIDER, RADIUS_SLIDER,
     RESTITUTION_RANGE, SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
 };
+use crate::sim::resting::RestingState;
 use crate::sim::{
     BallCountOutcome, CollisionMode, Intent, MassModel, RunControl, SimParams, Solver,
     SpawnSettings,
@@ -86,6 +87,7 @@ struct Shown<'w> {
     current: Res<'w, CurrentScene>,
     status: Res<'w, SceneStatus>,
     ball_count: Res<'w, BallCountOutcome>,
+    resting: Res<'w, RestingState>,
 }
 
 fn draw_panel(
@@ -321,6 +323,7 @@ fn view(ui: &mut egui::Ui, view: &mut ViewSettings) {
             ui.checkbox(&mut edited.show_contacts, "contact points");
             ui.checkbox(&mut edited.show_velocities, "velocity arrows");
             ui.checkbox(&mut edited.show_bursts, "collision bursts");
+            ui.checkbox(&mut edited.dim_sleeping, "dim sleeping balls");
             if edited != *view {
                 *view = edited;
             }
@@ -342,6 +345,7 @@ fn readouts(ui: &mut egui::Ui, shown: &Shown) {
                         format!("{:.1}", simulation_ms.unwrap_or(0.0)),
                     ),
                     ("balls", format!("{}", r.summary.ball_count)),
+                    ("sleeping", format!("{}", shown.resting.asleep)),
                     ("collisions /s", format!("{:.0}", r.collisions_per_second)),
                     (
                         "kinetic energy",

@@ -9,5 +9,6 @@ mod continuous;
 mod game;
 mod house;
 mod physics;
+mod piles;
 mod scenes;
 mod toy;

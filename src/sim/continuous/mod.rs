@@ -40,6 +40,9 @@ pub fn predict_impacts(
     snapshot: Res<BallSnapshot>,
     mut timeline: ResMut<Timeline>,
 ) {
+    if snapshot.all_held() {
+        return; // nothing flies: `run_timeline` has nothing to do either
+    }
     let spec = StepSpec::new(&params, clock.dt);
     timeline.predict(
         &snapshot.circles,
@@ -58,6 +61,9 @@ pub fn run_timeline(
     mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
     mut log: ResMut<StepLog>,
 ) {
+    if snapshot.all_held() {
+        return;
+    }
     let spec = StepSpec::new(&params, clock.dt);
     let BallSnapshot {
         entities,

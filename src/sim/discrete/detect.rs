@@ -31,6 +31,9 @@ pub fn detect_contacts(
     mut log: ResMut<StepLog>,
 ) {
     contacts.0.clear();
+    if snapshot.all_held() {
+        return; // nothing moved: the resting stage has every contact
+    }
     find_contacts(
         &snapshot.circles,
         solver.broad_phase,

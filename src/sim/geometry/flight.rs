@@ -68,6 +68,11 @@ pub fn time_to_touch(
 ) -> Option<f64> {
     let half_accel = accel * 0.5;
     let distance = offset.length();
+    // Too far to close the gap at the fastest it could close within the horizon.
+    let fastest = velocity.length() + accel.length() * horizon;
+    if distance - reach > fastest * horizon {
+        return None;
+    }
     // Monomial coefficients in t, the constant one without cancellation near contact.
     let c = [
         (distance - reach) * (distance + reach),

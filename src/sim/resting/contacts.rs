@@ -53,8 +53,6 @@ pub struct NearPairs {
     grid: UniformGrid,
     inflated: Vec<Circle>,
     found: Vec<IndexedContact>,
-    /// The two sides of each solver contact, for its warm start.
-    sides: Vec<(u32, Option<Wall>)>,
 }
 
 impl NearPairs {
@@ -142,7 +140,6 @@ impl NearPairs {
             })
             .collect();
         let mut contacts = Vec::new();
-        self.sides.clear();
         for &NearPair {
             a, b, gap, normal, ..
         } in &self.pairs
@@ -153,7 +150,6 @@ impl NearPairs {
                     RestingContact::new(a, Other::Body(b), normal, gap, warm_start.unwrap_or(0.0));
                 contact.push_out = solved(a as usize) && solved(b as usize);
                 contacts.push(contact);
-                self.sides.push((a, None));
             }
         }
         for &(ball, wall, gap) in &self.walls {
@@ -161,12 +157,11 @@ impl NearPairs {
                 let warm_start = warm.get(&wall_key(entities, ball, wall)).copied();
                 contacts.push(RestingContact::new(
                     ball,
-                    Other::Wall,
+                    Other::Wall(wall),
                     wall.outward_normal(),
                     gap,
                     warm_start.unwrap_or(0.0),
                 ));
-                self.sides.push((ball, Some(wall)));
             }
         }
         (bodies, contacts)
@@ -179,22 +174,18 @@ impl NearPairs {
         contacts: &'a [RestingContact],
         entities: &'a [Entity],
     ) -> impl Iterator<Item = ((u64, u64), f64)> + 'a {
-        for (contact, &(ball, wall)) in contacts.iter().zip(&self.sides) {
-            if wall.is_some() {
-                self.wall_impulse_of[ball as usize] += contact.step_impulse;
+        for contact in contacts {
+            if let Other::Wall(_) = contact.other {
+                self.wall_impulse_of[contact.a as usize] += contact.step_impulse;
             }
         }
-        contacts
-            .iter()
-            .zip(&self.sides)
-            .map(move |(contact, &(a, wall))| {
-                let key = match (contact.other, wall) {
-                    (Other::Body(b), _) => key(entities, a, Some(b)),
-                    (Other::Wall, Some(wall)) => wall_key(entities, a, wall),
-                    (Other::Wall, None) => unreachable!("a wall contact records its wall"),
-                };
-                (key, contact.impulse)
-            })
+        contacts.iter().map(move |contact| {
+            let key = match contact.other {
+                Other::Body(b) => key(entities, contact.a, Some(b)),
+                Other::Wall(wall) => wall_key(entities, contact.a, wall),
+            };
+            (key, contact.impulse)
+        })
     }
 
     /// The walls' impulse on all balls in the last solve.

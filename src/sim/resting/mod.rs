@@ -37,13 +37,15 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 pub use self::sleep::{SLEEP_SPEED, TIME_TO_SLEEP};
-use self::solver::{SoftStep, soft_step};
+use self::solver::{Other, RestingContact, SoftStep, soft_step};
 use self::state::MotionKey;
 pub use self::state::RestingState;
 use super::ball::{Ball, BallSnapshot, Position, Rest, RestState, Velocity};
 use super::clock::SimClock;
+use super::geometry::circle::collision_point;
+use super::geometry::wall::wall_contact_point;
 use super::params::{SimParams, Solver};
-use super::report::StepLog;
+use super::report::{Hit, StepLog};
 
 /// The resting speed is this many times the speed gravity adds in a step.
 pub const REST_SPEED_STEPS: f64 = 2.0;
@@ -100,6 +102,10 @@ pub fn rest_and_sleep(
     }
     state.wake_all |= changed || rest_speed == 0.0;
     let snapshot = &mut *snapshot;
+    if everyone_sleeps_undisturbed(state, &snapshot.held) {
+        log.resting_wall_impulse += state.island_load.values().sum::<f64>() * dt;
+        return; // sleeping costs nothing
+    }
     sleep::wake(state, &snapshot.held);
     state.near.find(
         &snapshot.circles,
@@ -108,12 +114,20 @@ pub fn rest_and_sleep(
         dt,
     );
     sleep::wake_touched(state);
-    let load = solve(state, snapshot, &params, dt);
+    let load = solve(state, snapshot, &params, dt, &mut log);
     log.resting_wall_impulse += load + state.island_load.values().sum::<f64>() * dt;
     classify(state, snapshot, rest_speed, dt);
     sleep::fall_asleep(state, &mut snapshot.velocities, dt);
     state.asleep = state.rests.iter().filter(|rest| rest.is_asleep()).count();
     write_back(snapshot, &state.rests, &mut balls);
+}
+
+/// Whether every ball sleeps, no hit disturbed one and nothing asks to wake them.
+fn everyone_sleeps_undisturbed(state: &RestingState, held: &[bool]) -> bool {
+    !state.wake_all
+        && state.wake_requests.is_empty()
+        && held.iter().all(|&held| held)
+        && state.rests.iter().all(Rest::is_asleep)
 }
 
 /// Each ball's [`Rest`], in the snapshot's order.
@@ -137,6 +151,7 @@ fn solve(
     snapshot: &mut BallSnapshot,
     params: &SimParams,
     dt: f64,
+    log: &mut StepLog,
 ) -> f64 {
     let solved =
         |index: usize| state.rests[index].state == RestState::Resting && snapshot.held[index];
@@ -163,6 +178,7 @@ fn solve(
         rest_speed: rest_speed(params, dt),
     };
     soft_step(&mut bodies, &mut contacts, step);
+    log_bounces(&contacts, snapshot, params, dt, log);
     let warm = state
         .near
         .warm_starts(&contacts, &snapshot.entities)
@@ -178,6 +194,39 @@ fn solve(
         }
     }
     state.near.total_wall_impulse()
+}
+
+/// The contacts that bounced in the solver are hits like any other, at the end of the step.
+fn log_bounces(
+    contacts: &[RestingContact],
+    snapshot: &BallSnapshot,
+    params: &SimParams,
+    dt: f64,
+    log: &mut StepLog,
+) {
+    for contact in contacts.iter().filter(|contact| contact.bounced) {
+        let circle = snapshot.circles[contact.a as usize];
+        let (impulse, closing_speed) = (contact.step_impulse, -contact.closing_velocity);
+        log.hits.push(match contact.other {
+            Other::Body(b) => Hit::Ball {
+                a: contact.a,
+                b,
+                time: dt,
+                point: collision_point(circle, snapshot.circles[b as usize]),
+                normal: contact.normal,
+                impulse,
+                closing_speed,
+            },
+            Other::Wall(wall) => Hit::Wall {
+                ball: contact.a,
+                wall,
+                time: dt,
+                point: wall_contact_point(wall, circle.center, params.half_extents()),
+                impulse,
+                normal_speed: closing_speed,
+            },
+        });
+    }
 }
 
 /// Step 4: who rests next step. A ball touching something (a ball or a wall) and slow enough

@@ -15,6 +15,8 @@
 
 use bevy::math::DVec2;
 
+use crate::sim::geometry::Wall;
+
 /// A body the solver moves, or an anchor it does not (`inverse_mass` 0): a ball.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Body {
@@ -45,7 +47,7 @@ pub enum Other {
     /// Another body, by index.
     Body(u32),
     /// A wall, which never moves.
-    Wall,
+    Wall(Wall),
 }
 
 /// A contact between body `a` and `other`, along `normal` (unit, from `a` towards `other`).
@@ -67,6 +69,8 @@ pub struct RestingContact {
     /// flight), no: the mode's stages separate those, and a push against an immovable
     /// neighbour only squeezes the ball against its other contacts.
     pub push_out: bool,
+    /// It bounced this step: a hit, not a resting contact.
+    pub bounced: bool,
 }
 
 impl RestingContact {
@@ -80,6 +84,7 @@ impl RestingContact {
             step_impulse: 0.0,
             closing_velocity: 0.0,
             push_out: true,
+            bounced: false,
         }
     }
 }
@@ -135,6 +140,7 @@ pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: Sof
     for contact in contacts.iter_mut() {
         contact.step_impulse = 0.0;
         contact.closing_velocity = normal_velocity(bodies, contact);
+        contact.bounced = false;
     }
     for _ in 0..substeps {
         integrate_velocities(bodies, step.gravity * h, decay);
@@ -174,6 +180,7 @@ fn apply_restitution(
         let applied = total - contact.impulse;
         contact.impulse = total;
         contact.step_impulse += applied;
+        contact.bounced = true;
         apply_impulse(bodies, contact, applied);
     }
 }
@@ -254,7 +261,7 @@ fn solve_contacts(
 fn other_body(bodies: &[Body], other: Other) -> Option<&Body> {
     match other {
         Other::Body(index) => Some(&bodies[index as usize]),
-        Other::Wall => None,
+        Other::Wall(_) => None,
     }
 }
 
@@ -291,7 +298,13 @@ mod tests {
         let bodies = (0..count)
             .map(|k| Body::new(DVec2::new(0.0, 10.0 + 20.0 * k as f64), DVec2::ZERO, 0.1))
             .collect();
-        let mut contacts = vec![RestingContact::new(0, Other::Wall, DVec2::NEG_Y, 0.0, 0.0)];
+        let mut contacts = vec![RestingContact::new(
+            0,
+            Other::Wall(Wall::Bottom),
+            DVec2::NEG_Y,
+            0.0,
+            0.0,
+        )];
         contacts.extend(
             (1..count).map(|k| {
                 RestingContact::new(k as u32 - 1, Other::Body(k as u32), DVec2::Y, 0.0, 0.0)
