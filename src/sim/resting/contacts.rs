@@ -3,7 +3,7 @@
 //! speculative contacts) ([`NearPairs`]), and from them the resting solver's bodies and
 //! contacts, warm-started from the impulses the same contacts carried last step.
 
-use std::collections::HashMap;
+use bevy::platform::collections::HashMap;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -48,6 +48,9 @@ pub struct NearPairs {
     pub walls: Vec<(u32, Wall, f64)>,
     /// Whether each ball touches a ball or a wall (within the margin, not speculatively).
     pub touching: Vec<bool>,
+    /// Whether each ball could touch a ball or a wall within the step (speculatively).
+    pub near: Vec<bool>,
+
     /// The walls' impulse on each ball in the last solve, mass x pixels per second.
     pub wall_impulse_of: Vec<f64>,
     grid: UniformGrid,
@@ -78,6 +81,9 @@ impl NearPairs {
         );
         self.touching.clear();
         self.touching.resize(circles.len(), false);
+        self.near.clear();
+        self.near.resize(circles.len(), false);
+
         self.wall_impulse_of.clear();
         self.wall_impulse_of.resize(circles.len(), 0.0);
         self.pairs.clear();
@@ -96,6 +102,8 @@ impl NearPairs {
             });
             self.touching[contact.a as usize] |= touching;
             self.touching[contact.b as usize] |= touching;
+            self.near[contact.a as usize] = true;
+            self.near[contact.b as usize] = true;
         }
         self.walls.clear();
         for (index, (circle, velocity)) in circles.iter().zip(velocities).enumerate() {
@@ -106,6 +114,7 @@ impl NearPairs {
                 if gap <= reach(circle, velocity) {
                     self.walls.push((index as u32, wall, gap));
                     self.touching[index] |= within_margin(gap, circle.radius);
+                    self.near[index] = true;
                 }
             }
         }

@@ -1,6 +1,8 @@
 //! The resting stage's state between steps: [`RestingState`].
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
+
+use bevy::platform::collections::HashMap;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
