@@ -120,6 +120,9 @@ pub struct BallSnapshot {
     /// Whether the ball is held still in the mode's stages (resting or asleep). The
     /// response clears it for a ball an impact sets moving.
     pub held: Vec<bool>,
+    /// Whether the response stopped the ball against a held one, to join the resting
+    /// solver at the next step (the continuous mode's impacts on a pile).
+    pub stopped: Vec<bool>,
 }
 
 impl BallSnapshot {
@@ -128,6 +131,7 @@ impl BallSnapshot {
         self.circles.clear();
         self.velocities.clear();
         self.held.clear();
+        self.stopped.clear();
     }
 
     /// Whether every ball is held still: the mode's stages then have nothing to do.
@@ -140,6 +144,7 @@ impl BallSnapshot {
         self.circles.push(circle);
         self.velocities.push(velocity);
         self.held.push(held);
+        self.stopped.push(false);
     }
 }
 

@@ -307,9 +307,9 @@ proptest! {
         let mut any_cut_short = false;
         for _ in 0..20 {
             let before = energy(&circles, &velocities);
-            let mut held = vec![false; circles.len()];
+            let (mut held, mut stopped) = (vec![false; circles.len()], vec![false; circles.len()]);
             timeline.predict(&circles, &velocities, &held, spec);
-            timeline.run(&mut circles, &mut velocities, &mut held, spec, |_| {});
+            timeline.run(&mut circles, &mut velocities, (&mut held, &mut stopped), spec, |_| {});
             let after = energy(&circles, &velocities);
             prop_assert!(all_finite(&velocities));
             prop_assert!(after <= before * (1.0 + 1e-9) + 1e-9, "energy grew {before} -> {after}");

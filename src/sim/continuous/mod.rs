@@ -70,9 +70,10 @@ pub fn run_timeline(
         circles,
         velocities,
         held,
+        stopped,
     } = &mut *snapshot;
     let log = &mut *log;
-    timeline.run(circles, velocities, held, spec, |hit| {
+    timeline.run(circles, velocities, (held, stopped), spec, |hit| {
         if let Hit::Ball { point, normal, .. } = hit {
             log.contacts.push(ContactPoint { point, normal });
         }

@@ -30,13 +30,14 @@ impl Timeline {
     /// The response stage's part: handles the predicted impacts in time order, predicting
     /// anew for every ball hit, then moves every ball to the end of the step. `circles`,
     /// `velocities` and `held` must be what [`predict`](Self::predict) was given; they are
-    /// updated in place (a held ball a hit sets flying is no longer held). Calls `on_hit`
-    /// for each hit, in the order handled.
+    /// updated in place (a held ball a hit sets flying is no longer held), and `stopped`
+    /// says which balls stopped against a held one. Calls `on_hit` for each hit, in the
+    /// order handled.
     pub fn run(
         &mut self,
         circles: &mut [Circle],
         velocities: &mut [DVec2],
-        held: &mut [bool],
+        (held, stopped): (&mut [bool], &mut [bool]),
         spec: StepSpec,
         mut on_hit: impl FnMut(Hit),
     ) {
@@ -50,7 +51,7 @@ impl Timeline {
                 None => self.collide(impact, spec, &mut on_hit),
             }
         }
-        self.move_to_the_end(circles, velocities, held, spec);
+        self.move_to_the_end(circles, velocities, (held, stopped), spec);
         if self.cut_short {
             self.resolve_what_was_cut_short(circles, velocities, held, spec, &mut on_hit);
         }
@@ -152,6 +153,10 @@ impl Timeline {
             self.come_to_rest(a, b, normal, now, spec);
             return;
         }
+        if spec.rest_speed > 0.0 && ma.still != mb.still {
+            self.stop_for_the_solver(if ma.still { b } else { a }, now, spec);
+            return;
+        }
         let Some(exchange) = normal_exchange(
             velocity_a,
             velocity_b,
@@ -209,6 +214,19 @@ impl Timeline {
         }
     }
 
+    /// A flying ball `index` meets a still one faster than the resting speed: the still one
+    /// rests in a pile the contact solver holds, where an impact is a simultaneous problem
+    /// (every contact of the pile at once, as Box2D solves it), not a chain of pairwise
+    /// exchanges. So the flying ball stops at the contact, keeping its velocity, and joins
+    /// the solver at the next step, whose restitution pass bounces it off the pile.
+    fn stop_for_the_solver(&mut self, index: usize, now: f64, spec: StepSpec) {
+        let mover = &mut self.movers[index];
+        mover.still = true;
+        mover.accel = DVec2::ZERO;
+        mover.hits += 1;
+        self.predict_for(index, now, spec);
+    }
+
     /// Ball `index` stops on a support that holds still (towards `into`, unit): it keeps only
     /// its velocity along the support's surface, for the end of the step, and holds still.
     fn stop_on_support(&mut self, index: usize, into: DVec2, now: f64, spec: StepSpec) {
@@ -220,23 +238,20 @@ impl Timeline {
         self.predict_for(index, now, spec);
     }
 
-    /// Every ball where the end of the step finds it.
+    /// Every ball where the end of the step finds it. A held ball stays held if nothing hit
+    /// it; a ball still now that was not held all along stopped against a held one.
     fn move_to_the_end(
         &mut self,
         circles: &mut [Circle],
         velocities: &mut [DVec2],
-        held: &mut [bool],
+        (held, stopped): (&mut [bool], &mut [bool]),
         spec: StepSpec,
     ) {
-        for (((circle, velocity), held), mover) in circles
-            .iter_mut()
-            .zip(velocities.iter_mut())
-            .zip(held.iter_mut())
-            .zip(&mut self.movers)
-        {
+        for (index, mover) in self.movers.iter_mut().enumerate() {
             mover.advance(spec.dt);
-            (circle.center, *velocity) = (mover.center, mover.velocity);
-            *held &= mover.still;
+            (circles[index].center, velocities[index]) = (mover.center, mover.velocity);
+            held[index] &= mover.still && mover.hits == 0;
+            stopped[index] = mover.still && !held[index];
         }
     }
 
@@ -377,12 +392,16 @@ mod tests {
         };
         let before = energy(&velocities, &circles);
         let mut timeline = Timeline::default();
-        let mut held = vec![false; 2];
+        let (mut held, mut stopped) = (vec![false; 2], vec![false; 2]);
         timeline.predict(&circles, &velocities, &held, spec);
         let mut hits = Vec::new();
-        timeline.run(&mut circles, &mut velocities, &mut held, spec, |hit| {
-            hits.push(hit)
-        });
+        timeline.run(
+            &mut circles,
+            &mut velocities,
+            (&mut held, &mut stopped),
+            spec,
+            |hit| hits.push(hit),
+        );
         assert_eq!(hits.len(), 1);
         let Hit::Ball { time, point, .. } = hits[0] else {
             panic!("a ball hit")

@@ -39,6 +39,7 @@ pub fn resolve_contacts(
         circles,
         velocities,
         held,
+        ..
     } = &mut *snapshot;
     in_contact.clear();
     in_contact.resize(entities.len(), false);

@@ -238,6 +238,7 @@ fn log_bounces(
 ///   further than [`HOLD_REACH`] of its radius in a step; any other flies, its impacts
 ///   exact. (Holding only balls slower than the resting speed lets the balls in a forming
 ///   pile collapse inelastically in flight: 1,000 balls then take 4.2 ms a step, not 0.7.)
+/// - Either mode: a ball the response stopped against a held one, at any speed.
 /// - Discrete: any ball that could touch something within the step, at any speed (Box2D's
 ///   speculative contacts: the solver stops it at the contact and bounces it there); only a
 ///   ball with nothing within reach flies. The tutorial's move-then-separate would melt a
@@ -261,7 +262,7 @@ fn classify(
             }
             CollisionMode::Discrete => state.near.near[index],
         };
-        let resting = rest_speed > 0.0 && in_contact;
+        let resting = rest_speed > 0.0 && (in_contact || snapshot.stopped[index]);
         rest.state = if resting {
             RestState::Resting
         } else {
