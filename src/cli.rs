@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
+use crate::commands::pile::{format_pile_table, run_pile};
 use crate::commands::run::{StateDump, run_scene_with_threads};
 use crate::commands::soak::soak;
 use crate::headless::DEFAULT_DT;
@@ -80,12 +81,17 @@ pub enum Command {
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
     /// Ball counts, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1_000, 10_000, 100_000],
+    #[arg(long, value_delimiter = ',',
           value_parser = clap::value_parser!(u64).range(1..=MAX_BENCH_BALLS))]
-    pub sizes: Vec<u64>,
-    /// Timed steps per case (after a short warm-up).
-    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=100_000))]
-    pub steps: u64,
+    pub sizes: Option<Vec<u64>>,
+    /// Timed steps per case (after a short warm-up); with `--pile`, steps from the start
+    /// [default: 200, with `--pile` 600 = 10 s]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub steps: Option<u64>,
+    /// Time the pile (`assets/scenes/pile.ron`, the standard gas under gravity with
+    /// restitution 0.5) in both modes instead of the gas [default sizes: 1000,10000].
+    #[arg(long)]
+    pub pile: bool,
     /// Run the all-pairs reference for sizes up to this (it is O(N^2)).
     #[arg(long, default_value_t = 10_000)]
     pub all_pairs_max: u64,
@@ -273,17 +279,22 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
 }
 
 fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
+    if args.pile {
+        return run_pile_bench(&args);
+    }
     let mut rows = Vec::new();
-    for &balls in &args.sizes {
+    let sizes = args.sizes.clone().unwrap_or(vec![1_000, 10_000, 100_000]);
+    let steps = args.steps.unwrap_or(200);
+    for balls in sizes {
         let balls = balls as usize;
         let discrete = BenchCase {
             balls,
-            steps: args.steps,
+            steps,
             broad_phase: BroadPhase::Grid,
             collisions: CollisionMode::Discrete,
         };
         let all_pairs = (balls as u64 <= args.all_pairs_max).then_some(BenchCase {
-            steps: (args.steps / 10).max(5),
+            steps: (steps / 10).max(5),
             broad_phase: BroadPhase::AllPairs,
             ..discrete
         });
@@ -310,6 +321,24 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         println!("{}", serde_json::to_string(&rows)?);
     } else {
         print!("{}", format_table(&rows));
+    }
+    Ok(())
+}
+
+fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
+    let mut rows = Vec::new();
+    for balls in args.sizes.clone().unwrap_or(vec![1_000, 10_000]) {
+        for mode in [CollisionMode::Continuous, CollisionMode::Discrete] {
+            rows.push(run_pile(balls as usize, mode, args.steps.unwrap_or(600))?);
+            if !args.json {
+                eprintln!("measured the pile of {balls} balls, {mode:?}");
+            }
+        }
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&rows)?);
+    } else {
+        print!("{}", format_pile_table(&rows));
     }
     Ok(())
 }

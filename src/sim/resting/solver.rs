@@ -160,26 +160,44 @@ pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: Sof
     for (contact, link) in contacts.iter_mut().zip(&work.links) {
         contact.impulse = link.impulse;
     }
-    for (index, body) in bodies.iter_mut().enumerate() {
-        (body.velocity, body.shift) = (work.velocity[index], work.shift[index]);
+    for (body, &slot) in bodies.iter_mut().zip(&work.slot_of) {
+        if slot != NO_SLOT {
+            let motion = work.motion[slot as usize];
+            (body.velocity, body.shift) = (motion.velocity, motion.shift);
+        }
     }
 }
 
-/// The solver's working arrays: each body's velocity, shift and inverse mass, with one more
-/// slot, an anchor that never moves, standing for the walls; and each contact's two slots and
-/// effective mass. The passes are plain loops over them.
+/// A body the solver has no slot for: an anchor no contact touches.
+const NO_SLOT: u32 = u32::MAX;
+
+/// The solver's working arrays. Each body a contact touches, and each movable one, has a
+/// slot, numbered in the order the contacts first name them (neighbours in space stay
+/// neighbours in memory), with its motion and inverse mass; one last slot, an anchor that
+/// never moves, stands for the walls. Each contact is a [`Link`]. The passes are plain loops
+/// over them.
 struct Work {
-    velocity: Vec<DVec2>,
-    shift: Vec<DVec2>,
+    motion: Vec<Motion>,
     inverse_mass: Vec<f64>,
     links: Vec<Link>,
+    /// Each body's slot, or [`NO_SLOT`].
+    slot_of: Vec<u32>,
 }
 
-/// What a pass reads of a contact, packed: its two slots in [`Work`], its effective mass (0
-/// if neither side moves), normal, starting gap and impulse.
+/// A body's velocity and how far it has moved, side by side: what every contact reads.
+#[derive(Clone, Copy, Debug, Default)]
+struct Motion {
+    velocity: DVec2,
+    shift: DVec2,
+}
+
+/// What a pass reads of a contact, packed: its two slots, their inverse masses and its
+/// effective mass (0 if neither side moves), normal, starting gap and impulse.
 struct Link {
     a: u32,
     b: u32,
+    inverse_mass_a: f64,
+    inverse_mass_b: f64,
     mass: f64,
     normal: DVec2,
     separation: f64,
@@ -189,32 +207,58 @@ struct Link {
 
 impl Work {
     fn new(bodies: &[Body], contacts: &[RestingContact]) -> Self {
-        let anchor = bodies.len();
         let mut work = Work {
-            velocity: bodies.iter().map(|body| body.velocity).collect(),
-            shift: bodies.iter().map(|body| body.shift).collect(),
-            inverse_mass: bodies.iter().map(|body| body.inverse_mass).collect(),
+            motion: Vec::with_capacity(bodies.len() + 1),
+            inverse_mass: Vec::with_capacity(bodies.len() + 1),
             links: Vec::with_capacity(contacts.len()),
+            slot_of: vec![NO_SLOT; bodies.len()],
         };
-        work.velocity.push(DVec2::ZERO);
-        work.shift.push(DVec2::ZERO);
-        work.inverse_mass.push(0.0);
+        let slot = |work: &mut Work, index: u32| {
+            let existing = work.slot_of[index as usize];
+            if existing != NO_SLOT {
+                return existing;
+            }
+            let body = &bodies[index as usize];
+            work.slot_of[index as usize] = work.motion.len() as u32;
+            work.motion.push(Motion {
+                velocity: body.velocity,
+                shift: body.shift,
+            });
+            work.inverse_mass.push(body.inverse_mass);
+            work.slot_of[index as usize]
+        };
+        let mut ends = Vec::with_capacity(contacts.len());
         for contact in contacts {
-            let a = contact.a;
+            let a = slot(&mut work, contact.a);
             let b = match contact.other {
-                Other::Body(index) => index,
-                Other::Wall(_) => anchor as u32,
+                Other::Body(index) => Some(slot(&mut work, index)),
+                Other::Wall(_) => None,
             };
-            let inverse_masses = work.inverse_mass[a as usize] + work.inverse_mass[b as usize];
-            let mass = if inverse_masses > 0.0 {
-                1.0 / inverse_masses
-            } else {
-                0.0
-            };
+            ends.push((a, b));
+        }
+        for (index, body) in bodies.iter().enumerate() {
+            if body.inverse_mass > 0.0 {
+                slot(&mut work, index as u32);
+            }
+        }
+        let anchor = work.motion.len() as u32;
+        work.motion.push(Motion::default());
+        work.inverse_mass.push(0.0);
+        for (contact, (a, b)) in contacts.iter().zip(ends) {
+            let b = b.unwrap_or(anchor);
+            let (inverse_mass_a, inverse_mass_b) =
+                (work.inverse_mass[a as usize], work.inverse_mass[b as usize]);
+            let inverse_masses = inverse_mass_a + inverse_mass_b;
             work.links.push(Link {
                 a,
                 b,
-                mass,
+                inverse_mass_a,
+                inverse_mass_b,
+                mass: if inverse_masses > 0.0 {
+                    1.0 / inverse_masses
+                } else {
+                    0.0
+                },
                 normal: contact.normal,
                 separation: contact.separation,
                 impulse: contact.impulse,
@@ -226,56 +270,51 @@ impl Work {
 
     /// The contact's relative normal velocity, `b` minus `a`: negative when closing.
     #[inline]
-    fn normal_velocity(velocity: &[DVec2], link: &Link) -> f64 {
-        (velocity[link.b as usize] - velocity[link.a as usize]).dot(link.normal)
+    fn normal_velocity(motion: &[Motion], link: &Link) -> f64 {
+        (motion[link.b as usize].velocity - motion[link.a as usize].velocity).dot(link.normal)
     }
 
     /// Pushes the contact's sides apart along its normal with `impulse`.
     #[inline]
-    fn apply_impulse(velocity: &mut [DVec2], inverse_mass: &[f64], link: &Link, impulse: f64) {
+    fn apply_impulse(motion: &mut [Motion], link: &Link, impulse: f64) {
         let push = link.normal * impulse;
-        let (a, b) = (link.a as usize, link.b as usize);
-        velocity[a] -= push * inverse_mass[a];
-        velocity[b] += push * inverse_mass[b];
+        motion[link.a as usize].velocity -= push * link.inverse_mass_a;
+        motion[link.b as usize].velocity += push * link.inverse_mass_b;
     }
 
     /// The normal speed at which the link's sides meet (see
     /// [`RestingContact::closing_velocity`]).
     fn speed_at_contact(&self, link: &Link, gravity: DVec2) -> f64 {
-        let speed = Self::normal_velocity(&self.velocity, link);
+        let speed = Self::normal_velocity(&self.motion, link);
         if link.separation <= 0.0 || speed >= 0.0 {
             return speed;
         }
-        let falls = |slot: u32| f64::from(u8::from(self.inverse_mass[slot as usize] > 0.0));
-        let accel = (falls(link.b) - falls(link.a)) * gravity.dot(link.normal);
+        let falls = |inverse_mass: f64| f64::from(u8::from(inverse_mass > 0.0));
+        let accel =
+            (falls(link.inverse_mass_b) - falls(link.inverse_mass_a)) * gravity.dot(link.normal);
         -(speed * speed - 2.0 * accel * link.separation)
             .max(0.0)
             .sqrt()
     }
 
     fn integrate_velocities(&mut self, gain: DVec2, decay: f64) {
-        for (velocity, &inverse_mass) in self.velocity.iter_mut().zip(&self.inverse_mass) {
+        for (motion, &inverse_mass) in self.motion.iter_mut().zip(&self.inverse_mass) {
             if inverse_mass > 0.0 {
-                *velocity = (*velocity + gain) * decay;
+                motion.velocity = (motion.velocity + gain) * decay;
             }
         }
     }
 
     fn warm_start(&mut self) {
         for link in &self.links {
-            Self::apply_impulse(&mut self.velocity, &self.inverse_mass, link, link.impulse);
+            Self::apply_impulse(&mut self.motion, link, link.impulse);
         }
     }
 
     fn integrate_positions(&mut self, h: f64) {
-        for ((shift, velocity), &inverse_mass) in self
-            .shift
-            .iter_mut()
-            .zip(&self.velocity)
-            .zip(&self.inverse_mass)
-        {
+        for (motion, &inverse_mass) in self.motion.iter_mut().zip(&self.inverse_mass) {
             if inverse_mass > 0.0 {
-                *shift += *velocity * h;
+                motion.shift += motion.velocity * h;
             }
         }
     }
@@ -288,11 +327,11 @@ impl Work {
     /// push-out cap) an overlap is pushed out softly; without, only the approach is removed.
     /// A gap still open (a speculative contact) may close within the substep but not beyond.
     fn solve_contacts(&mut self, h: f64, bias: Option<(Softness, f64)>) {
-        let (velocity, shift, inverse_mass) = (&mut self.velocity, &self.shift, &self.inverse_mass);
+        let motion = &mut self.motion;
         for link in self.links.iter_mut().filter(|link| link.mass > 0.0) {
-            let relative_shift = shift[link.b as usize] - shift[link.a as usize];
-            let separation = link.separation + relative_shift.dot(link.normal);
-            let normal_speed = Self::normal_velocity(velocity, link);
+            let (a, b) = (motion[link.a as usize], motion[link.b as usize]);
+            let separation = link.separation + (b.shift - a.shift).dot(link.normal);
+            let normal_speed = (b.velocity - a.velocity).dot(link.normal);
             let (push, mass_scale, impulse_scale) = match bias {
                 _ if separation > 0.0 => (separation / h, 1.0, 0.0),
                 Some((soft, max_push_speed)) if link.push_out => (
@@ -307,7 +346,7 @@ impl Work {
             let total = (link.impulse + change).max(0.0);
             let applied = total - link.impulse;
             link.impulse = total;
-            Self::apply_impulse(velocity, inverse_mass, link, applied);
+            Self::apply_impulse(motion, link, applied);
         }
     }
 
@@ -328,14 +367,14 @@ impl Work {
             {
                 continue;
             }
-            let normal_speed = Self::normal_velocity(&self.velocity, link);
+            let normal_speed = Self::normal_velocity(&self.motion, link);
             let change = -(normal_speed + restitution * contact.closing_velocity) * link.mass;
             let total = (link.impulse + change).max(0.0);
             let applied = total - link.impulse;
             link.impulse = total;
             contact.step_impulse += applied;
             contact.bounced = true;
-            Self::apply_impulse(&mut self.velocity, &self.inverse_mass, link, applied);
+            Self::apply_impulse(&mut self.motion, link, applied);
         }
     }
 }
