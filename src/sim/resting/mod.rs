@@ -12,7 +12,7 @@
 //!
 //! 1. `wake`: every sleeping island whose ball a hit set flying, that an intent asked for, or
 //!    all of them if a parameter that shapes the motion changed (gravity, restitution, mass
-//!    model, arena, mode);
+//!    model, arena, mode), every ball then put back inside the arena;
 //! 2. `find_near_pairs`: the grid's pairs within a small margin of touching, and each ball's
 //!    walls within it; an awake ball touching a sleeping island wakes it;
 //! 3. `solve`: the balls that rested through the mode's stages (held still there) take one
@@ -44,8 +44,14 @@ use super::ball::{Ball, BallSnapshot, Position, Rest, RestState, Velocity};
 use super::clock::SimClock;
 use super::geometry::circle::collision_point;
 use super::geometry::wall::wall_contact_point;
-use super::params::{CollisionMode, SimParams, Solver};
+use super::params::{CollisionMode, MAX_SPEED, SimParams, Solver};
 use super::report::{Hit, StepLog};
+
+/// The resting solver's contact stiffness for a step of `dt` seconds, hertz: an overlap of
+/// `δ` between balls of effective mass `m` stores `½·m·(2π·hertz)²·δ²` like a spring.
+pub fn contact_hertz(dt: f64) -> f64 {
+    CONTACT_STIFFNESS * f64::from(SUBSTEPS) / dt
+}
 
 /// The resting speed is this many times the speed gravity adds in a step.
 pub const REST_SPEED_STEPS: f64 = 2.0;
@@ -104,6 +110,9 @@ pub fn rest_and_sleep(
     }
     state.wake_all |= changed || rest_speed == 0.0;
     let snapshot = &mut *snapshot;
+    if changed {
+        keep_inside(snapshot, params.half_extents());
+    }
     if everyone_sleeps_undisturbed(state, &snapshot.held) {
         log.resting_wall_impulse += state.island_load.values().sum::<f64>() * dt;
         return; // sleeping costs nothing
@@ -122,6 +131,15 @@ pub fn rest_and_sleep(
     sleep::fall_asleep(state, &mut snapshot.velocities, dt);
     state.asleep = state.rests.iter().filter(|rest| rest.is_asleep()).count();
     write_back(snapshot, &state.rests, &mut balls);
+}
+
+/// Puts every ball back inside the arena `[-half, half]`: after a resize the mode's stages
+/// contain only the balls they move, and held ones may have been left outside.
+fn keep_inside(snapshot: &mut BallSnapshot, half: DVec2) {
+    for circle in &mut snapshot.circles {
+        let limit = (half - DVec2::splat(circle.radius)).max(DVec2::ZERO);
+        circle.center = circle.center.clamp(-limit, limit);
+    }
 }
 
 /// Whether every ball sleeps, no hit disturbed one and nothing asks to wake them.
@@ -173,7 +191,7 @@ fn solve(
         substeps: SUBSTEPS,
         gravity: params.gravity,
         damping: params.linear_damping,
-        hertz: CONTACT_STIFFNESS * f64::from(SUBSTEPS) / dt,
+        hertz: contact_hertz(dt),
         damping_ratio: CONTACT_DAMPING_RATIO,
         max_push_speed: MAX_PUSH_SPEED,
         restitution: params.restitution,
@@ -192,7 +210,8 @@ fn solve(
             let circle = &mut snapshot.circles[index];
             let limit = (half - DVec2::splat(circle.radius)).max(DVec2::ZERO);
             circle.center = (body.position + body.shift).clamp(-limit, limit);
-            snapshot.velocities[index] = body.velocity;
+            // A safety net: no velocity leaves the solver faster than any ball may go.
+            snapshot.velocities[index] = body.velocity.clamp_length_max(MAX_SPEED);
         }
     }
     state.near.total_wall_impulse()
