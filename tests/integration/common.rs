@@ -65,6 +65,17 @@ pub fn states(app: &mut App) -> Vec<BallState> {
     balls.into_iter().map(|(_, state)| state).collect()
 }
 
+/// The entity of the ball with id `id`.
+pub fn entity_of(app: &mut App, id: u32) -> Entity {
+    let world = app.world_mut();
+    world
+        .query::<(Entity, &BallId)>()
+        .iter(world)
+        .find(|(_, ball_id)| ball_id.0 == id)
+        .map(|(entity, _)| entity)
+        .expect("a ball with that id")
+}
+
 /// Every ball's radius by entity, to look up the balls a collision message names.
 pub fn radii_by_entity(app: &mut App) -> std::collections::HashMap<Entity, f64> {
     let world = app.world_mut();

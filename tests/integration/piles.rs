@@ -205,16 +205,6 @@ fn sleeping_column(mode: CollisionMode) -> App {
     app
 }
 
-fn entity_of(app: &mut App, id: u32) -> Entity {
-    let world = app.world_mut();
-    world
-        .query::<(Entity, &BallId)>()
-        .iter(world)
-        .find(|(_, ball_id)| ball_id.0 == id)
-        .map(|(entity, _)| entity)
-        .unwrap()
-}
-
 #[test]
 fn a_sleeping_pile_wakes_at_every_disturbance() {
     type Disturbance = fn(&mut App);

@@ -31,17 +31,6 @@ fn single_step_runs_exactly_one_step_while_paused() {
     assert_eq!(app.world().resource::<RunControl>().pending_steps, 0);
 }
 
-/// The entity of the ball with id `id`.
-fn entity_of(app: &mut App, id: u32) -> Entity {
-    let world = app.world_mut();
-    world
-        .query::<(Entity, &BallId)>()
-        .iter(world)
-        .find(|(_, ball_id)| ball_id.0 == id)
-        .map(|(entity, _)| entity)
-        .expect("a ball with that id")
-}
-
 #[test]
 fn intents_apply_at_the_next_fixed_step_even_while_paused() {
     for mode in CollisionMode::ALL {
