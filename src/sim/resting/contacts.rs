@@ -8,7 +8,7 @@ use bevy::platform::collections::HashMap;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::solver::{Body, Other, RestingContact};
+use super::constraint::{Body, Other, RestingContact};
 use crate::sim::geometry::circle::{Circle, contact_normal};
 use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
@@ -38,6 +38,15 @@ pub struct NearPair {
 fn within_margin(gap: f64, radii: f64) -> bool {
     gap <= CONTACT_MARGIN * radii
 }
+
+/// Whether an overlap of `-gap` pixels between balls (or a ball and a wall) of radii summing
+/// to `radii` is deeper than the margin: a jam being pushed out, not an impact.
+fn too_deep(gap: f64, radii: f64) -> bool {
+    gap < -DEEP_OVERLAP * radii
+}
+
+/// An overlap deeper than this fraction of the radii is a jam being pushed out.
+pub const DEEP_OVERLAP: f64 = 0.1;
 
 /// Pairs and walls near touching, found anew each step.
 #[derive(Debug, Default)]
@@ -158,19 +167,23 @@ impl NearPairs {
                 let mut contact =
                     RestingContact::new(a, Other::Body(b), normal, gap, warm_start.unwrap_or(0.0));
                 contact.push_out = solved(a as usize) && solved(b as usize);
+                let radii = circles[a as usize].radius + circles[b as usize].radius;
+                contact.may_bounce = !too_deep(gap, radii);
                 contacts.push(contact);
             }
         }
         for &(ball, wall, gap) in &self.walls {
             if solved(ball as usize) {
                 let warm_start = warm.get(&wall_key(entities, ball, wall)).copied();
-                contacts.push(RestingContact::new(
+                let mut contact = RestingContact::new(
                     ball,
                     Other::Wall(wall),
                     wall.outward_normal(),
                     gap,
                     warm_start.unwrap_or(0.0),
-                ));
+                );
+                contact.may_bounce = !too_deep(gap, circles[ball as usize].radius);
+                contacts.push(contact);
             }
         }
         (bodies, contacts)

@@ -28,6 +28,7 @@
 //! resting ball moves only here, and a sleeping one not at all: its state is bit-identical
 //! from step to step.
 
+mod constraint;
 mod contacts;
 mod sleep;
 pub mod solver;

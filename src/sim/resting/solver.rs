@@ -15,82 +15,7 @@
 
 use bevy::math::DVec2;
 
-use crate::sim::geometry::Wall;
-
-/// A body the solver moves, or an anchor it does not (`inverse_mass` 0): a ball.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Body {
-    /// Pixels, at the start of the step; unchanged by the solver (see `shift`).
-    pub position: DVec2,
-    /// Pixels per second.
-    pub velocity: DVec2,
-    /// 1 / mass; 0 for an anchor.
-    pub inverse_mass: f64,
-    /// How far the solver has moved it this step, pixels.
-    pub shift: DVec2,
-}
-
-impl Body {
-    pub fn new(position: DVec2, velocity: DVec2, inverse_mass: f64) -> Self {
-        Self {
-            position,
-            velocity,
-            inverse_mass,
-            shift: DVec2::ZERO,
-        }
-    }
-}
-
-/// What a contact's second side is.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Other {
-    /// Another body, by index.
-    Body(u32),
-    /// A wall, which never moves.
-    Wall(Wall),
-}
-
-/// A contact between body `a` and `other`, along `normal` (unit, from `a` towards `other`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RestingContact {
-    pub a: u32,
-    pub other: Other,
-    pub normal: DVec2,
-    /// Gap at the start of the step, pixels: negative when overlapping.
-    pub separation: f64,
-    /// Normal impulse of the last substep (the warm start), mass x pixels per second, ≥ 0.
-    pub impulse: f64,
-    /// Normal impulse over the whole step so far: what a wall carried, for the pressure.
-    pub step_impulse: f64,
-    /// Normal speed at contact, negative when closing, pixels per second: what restitution
-    /// reverses. The speed at the start of the step, and for a gap still open the speed the
-    /// sides would meet at in free flight across it (gravity pulls a ball onto a wall, not
-    /// onto a ball that falls with it). Never the speed other contacts' push-outs give it: a
-    /// pushed pile would bounce forever.
-    pub closing_velocity: f64,
-    /// Whether an overlap is pushed out. Against a ball the solver does not move (one in
-    /// flight), no: the mode's stages separate those, and a push against an immovable
-    /// neighbour only squeezes the ball against its other contacts.
-    pub push_out: bool,
-    /// It bounced this step: a hit, not a resting contact.
-    pub bounced: bool,
-}
-
-impl RestingContact {
-    pub fn new(a: u32, other: Other, normal: DVec2, separation: f64, warm: f64) -> Self {
-        Self {
-            a,
-            other,
-            normal,
-            separation,
-            impulse: warm,
-            step_impulse: 0.0,
-            closing_velocity: 0.0,
-            push_out: true,
-            bounced: false,
-        }
-    }
-}
+pub use super::constraint::{Body, Other, RestingContact};
 
 /// The soft step's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -361,6 +286,7 @@ impl Work {
     ) {
         for (contact, link) in contacts.iter_mut().zip(&mut self.links) {
             if restitution == 0.0
+                || !contact.may_bounce
                 || contact.closing_velocity > -rest_speed
                 || contact.step_impulse == 0.0
                 || link.mass == 0.0
@@ -382,6 +308,7 @@ impl Work {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::geometry::Wall;
 
     fn other_body(bodies: &[Body], other: Other) -> Option<&Body> {
         match other {
@@ -486,5 +413,28 @@ mod tests {
             (100.0..100.0 + 500.0 / 60.0 / 4.0).contains(&bounce),
             "{bounce}"
         );
+    }
+
+    #[test]
+    fn a_jam_being_pushed_out_does_not_bounce() {
+        // A ball 3 px deep in the floor, moving into it at 200 px/s: as a fresh impact it
+        // would bounce at 100 px/s; as a jam (it may not bounce) it only stops.
+        let run = |may_bounce: bool| {
+            let mut bodies = vec![Body::new(
+                DVec2::new(0.0, 7.0),
+                DVec2::new(0.0, -200.0),
+                0.1,
+            )];
+            let mut contact =
+                RestingContact::new(0, Other::Wall(Wall::Bottom), DVec2::NEG_Y, -3.0, 0.0);
+            contact.may_bounce = may_bounce;
+            let mut contacts = vec![contact];
+            soft_step(&mut bodies, &mut contacts, STEP);
+            (bodies[0].velocity.y, contacts[0].bounced)
+        };
+        let (bounced_speed, bounced) = run(true);
+        assert!(bounced && bounced_speed > 90.0, "{bounced_speed}");
+        let (jammed_speed, bounced) = run(false);
+        assert!(!bounced && jammed_speed < 20.0, "{jammed_speed}");
     }
 }
