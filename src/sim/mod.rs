@@ -30,7 +30,7 @@
 //! **Gravity and piles**: exact ballistic flight is pure maths in [`geometry::flight`], used
 //! by the continuous timeline's `Mover`, its swept circles and the wall time of impact.
 //! Balls that rest on others, and islands of them that sleep, are [`resting`]'s: both modes
-//! hold them still (their [`Rest`](ball::Rest) says so), and the resting stage alone moves
+//! hold them still (their [`Rest`] says so), and the resting stage alone moves
 //! the resting ones, with a soft contact solver.
 
 pub mod aim;

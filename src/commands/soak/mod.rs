@@ -9,7 +9,7 @@
 //! where it was. A panic in a step counts as a failure of that scene.
 //!
 //! Each scene has its own seed, printed with its result; `--seed <that> --scenes 1` replays it.
-//! [`scene`] draws the scenes.
+//! `scene.rs` draws the scenes.
 
 mod scene;
 

@@ -37,7 +37,7 @@ pub struct StepSpec {
     /// is a parabola.
     pub gravity: DVec2,
     /// Impacts closing slower than this, pixels per second, do not bounce: the resting rule
-    /// ([`rest_speed`](crate::sim::resting::rest_speed)).
+    /// ([`rest_speed`]).
     pub rest_speed: f64,
 }
 

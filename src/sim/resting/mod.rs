@@ -13,13 +13,14 @@
 //! 1. `wake`: every sleeping island whose ball a hit set flying, that an intent asked for, or
 //!    all of them if a parameter that shapes the motion changed (gravity, restitution, mass
 //!    model, arena, mode), every ball then put back inside the arena;
-//! 2. `find_near_pairs`: the grid's pairs within a small margin of touching, and each ball's
-//!    walls within it; an awake ball touching a sleeping island wakes it;
+//! 2. near pairs (`contacts.rs`): the grid's pairs, and each ball's walls, that touch within
+//!    a small margin or could within the step; an awake ball touching a sleeping island wakes
+//!    it;
 //! 3. `solve`: the balls that rested through the mode's stages (held still there) take one
 //!    soft step of [`solver`] with their contacts (balls that are not resting are
-//!    immovable anchors for it); the walls' impulses count towards the pressure;
-//! 4. `classify`: a ball that touches something and is no faster than the resting speed
-//!    rests next step, any other flies;
+//!    immovable anchors for it); the walls' impulses count towards the pressure, and the
+//!    bounces it applies are hits;
+//! 4. `classify`: who rests next step, by mode (its comment says how);
 //! 5. `fall_asleep`: islands of touching resting balls, each ball slower than
 //!    [`SLEEP_SPEED`] for [`TIME_TO_SLEEP`] and none touching a flying ball, sleep (velocity
 //!    exactly zero) until woken; the weight they put on the walls keeps counting.

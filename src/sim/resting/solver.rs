@@ -2,12 +2,13 @@
 //! contacts in, new velocities, positions and contact impulses out.
 //!
 //! A step is split into substeps; each substep is the same short list of named passes as
-//! Box2D's `solver.c`: [`integrate_velocities`] (gravity, damping), [`warm_start`] (the
-//! impulses the contacts carried last substep), [`solve_contacts`] with a soft bias that
-//! pushes overlaps out at a capped speed, [`integrate_positions`], and [`relax_contacts`]
-//! (the same solve without the bias, so the push-out leaves no velocity behind); then, once
-//! per step, [`apply_restitution`] to the contacts that closed faster than the resting speed
-//! when the step began (the resting rule: slower ones do not bounce).
+//! Box2D's `solver.c` (methods of `Work`): `integrate_velocities` (gravity, damping),
+//! `warm_start` (the impulses the contacts carried last substep), `solve_contacts` with a soft
+//! bias that pushes overlaps out at a capped speed, `integrate_positions`, and
+//! `relax_contacts` (the same solve without the bias, so the push-out leaves no velocity
+//! behind); then, once per step, `apply_restitution` to the contacts that closed at the
+//! resting speed or faster (the resting rule: slower ones do not bounce) and did not begin
+//! the step deep in an overlap.
 //!
 //! Soft contacts (a spring of `hertz` with damping ratio `damping_ratio`, Box2D's
 //! `b2MakeSoft`) and warm starting are what let a deep pile hold still with a few
