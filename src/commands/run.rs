@@ -58,16 +58,67 @@ pub struct RunReport {
 }
 
 impl RunReport {
-    /// The report as aligned `name  value` lines.
+    /// The report as aligned `name  value` lines, pairs as `x, y`, and the speed histogram
+    /// as a table with a bar per bin: nothing a person has to read as JSON (`--json` has it
+    /// all as JSON).
     pub fn to_text(&self) -> String {
         let value = serde_json::to_value(self).expect("a report is plain numbers");
         let fields = value.as_object().expect("a report serialises to an object");
         let width = fields.keys().map(String::len).max().unwrap_or(0);
-        fields
-            .iter()
-            .map(|(name, value)| format!("{name:<width$}  {value}\n"))
-            .collect()
+        let mut text = String::new();
+        for (name, value) in fields {
+            let shown = match value {
+                serde_json::Value::Array(items) => items
+                    .iter()
+                    .map(ToString::to_string)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                serde_json::Value::Object(_) => histogram_heading(&self.speed_histogram),
+                other => other.to_string(),
+            };
+            text.push_str(&format!("{name:<width$}  {shown}\n"));
+            if name == "speed_histogram" {
+                text.push_str(&histogram_rows(&self.speed_histogram));
+            }
+        }
+        text
     }
+}
+
+/// Widest bar of the text histogram, characters.
+const HISTOGRAM_BAR: usize = 40;
+
+fn histogram_heading(histogram: &SpeedHistogram) -> String {
+    format!(
+        "{} bins of {:.1} px/s; balls per bin, and as many as the 2-D Maxwell–Boltzmann \
+         distribution at this temperature expects:",
+        histogram.counts.len(),
+        histogram.bin_width
+    )
+}
+
+/// One line per bin up to the last that holds a ball or expects half of one: the speeds,
+/// the count, the expected count and a bar of the count.
+fn histogram_rows(histogram: &SpeedHistogram) -> String {
+    let shown = (0..histogram.counts.len())
+        .rev()
+        .find(|&bin| histogram.counts[bin] > 0 || histogram.expected[bin] >= 0.5)
+        .map_or(0, |last| last + 1);
+    let largest = histogram.counts.iter().copied().max().unwrap_or(0).max(1);
+    (0..shown)
+        .map(|bin| {
+            let (low, high) = (
+                bin as f64 * histogram.bin_width,
+                (bin + 1) as f64 * histogram.bin_width,
+            );
+            let count = histogram.counts[bin];
+            let bar = "#".repeat((count as usize * HISTOGRAM_BAR).div_ceil(largest as usize));
+            format!(
+                "    {low:>8.1} – {high:<8.1} {count:>7} {:>9.1}  {bar}\n",
+                histogram.expected[bin]
+            )
+        })
+        .collect()
 }
 
 /// Loads `setup` into a fresh headless app and runs `steps` fixed steps of `dt` seconds,

@@ -88,6 +88,10 @@ fn run_prints_a_readable_report_by_default() {
             "missing {field} in\n{text}"
         );
     }
+    // Nothing to read as JSON: pairs as `x, y`, the histogram as rows with bars.
+    assert!(!text.contains(['{', '[']), "{text}");
+    let rows = text.lines().filter(|line| line.contains(" – ")).count();
+    assert!(rows >= 1 && text.contains('#'), "{text}");
 }
 
 #[test]
