@@ -12,7 +12,8 @@ use clap::{Parser, Subcommand};
 
 use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
 use crate::commands::pile::{format_pile_table, run_pile};
-use crate::commands::run::{StateDump, run_scene_with_threads};
+use crate::commands::progress::Progress;
+use crate::commands::run::{StateDump, run_scene_showing};
 use crate::commands::soak::soak;
 use crate::headless::DEFAULT_DT;
 use crate::sim::params::MAX_BALLS;
@@ -98,6 +99,9 @@ pub struct BenchArgs {
     /// Print the rows as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// No progress bar (it is drawn on stderr only when stderr is a terminal).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -114,6 +118,9 @@ pub struct SoakArgs {
     /// Most balls in a scene.
     #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=MAX_BENCH_BALLS))]
     pub max_balls: u64,
+    /// No progress bar (it is drawn on stderr only when stderr is a terminal).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -159,6 +166,9 @@ pub struct RunArgs {
     /// Collision mode, overriding the scene's (default: continuous).
     #[arg(long, value_enum)]
     pub collisions: Option<CollisionMode>,
+    /// No progress bar (it is drawn on stderr only when stderr is a terminal).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 fn parse_step_seconds(text: &str) -> Result<f64, String> {
@@ -263,7 +273,9 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     override_scene(&mut scene, &origin, args.collisions, args.balls, args.seed)?;
     let setup = scene.build(&origin)?;
     let threads = args.threads.map(|n| n as usize);
-    let (mut app, report) = run_scene_with_threads(&setup, args.steps, args.dt, threads);
+    let progress = Progress::new(args.steps, "steps", args.quiet);
+    let (mut app, report) = run_scene_showing(&setup, args.steps, args.dt, threads, &progress);
+    drop(progress);
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {
@@ -285,6 +297,7 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     let mut rows = Vec::new();
     let sizes = args.sizes.clone().unwrap_or(vec![1_000, 10_000, 100_000]);
     let steps = args.steps.unwrap_or(200);
+    let progress = Progress::new(sizes.len() as u64, "sizes", args.quiet || args.json);
     for balls in sizes {
         let balls = balls as usize;
         let discrete = BenchCase {
@@ -312,11 +325,10 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
             continuous_one_core: run_case_in_child(continuous, true)?,
             continuous_all_cores: run_case_in_child(continuous, false)?,
         };
-        if !args.json {
-            eprintln!("measured {balls} balls");
-        }
         rows.push(row);
+        progress.advance(1);
     }
+    drop(progress);
     if args.json {
         println!("{}", serde_json::to_string(&rows)?);
     } else {
@@ -327,14 +339,15 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
 
 fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
     let mut rows = Vec::new();
-    for balls in args.sizes.clone().unwrap_or(vec![1_000, 10_000]) {
+    let sizes = args.sizes.clone().unwrap_or(vec![1_000, 10_000]);
+    let progress = Progress::new(2 * sizes.len() as u64, "cases", args.quiet || args.json);
+    for balls in sizes {
         for mode in [CollisionMode::Continuous, CollisionMode::Discrete] {
             rows.push(run_pile(balls as usize, mode, args.steps.unwrap_or(600))?);
-            if !args.json {
-                eprintln!("measured the pile of {balls} balls, {mode:?}");
-            }
+            progress.advance(1);
         }
     }
+    drop(progress);
     if args.json {
         println!("{}", serde_json::to_string(&rows)?);
     } else {
@@ -344,7 +357,13 @@ fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
 }
 
 fn run_soak(args: SoakArgs) -> Result<(), Box<dyn Error>> {
-    let failed = soak(args.seed, args.scenes, args.steps, args.max_balls as usize);
+    let failed = soak(
+        args.seed,
+        args.scenes,
+        args.steps,
+        args.max_balls as usize,
+        args.quiet,
+    );
     if failed > 0 {
         return Err(format!("{failed} of {} scenes failed", args.scenes).into());
     }

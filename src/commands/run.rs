@@ -5,6 +5,7 @@
 use bevy::prelude::*;
 use serde::Serialize;
 
+use super::progress::Progress;
 use crate::headless::{headless_app_with_threads, mean, median, time_steps};
 use crate::sim::measure::gas::SpeedHistogram;
 use crate::sim::{
@@ -135,10 +136,21 @@ pub fn run_scene_with_threads(
     dt: f64,
     compute_threads: Option<usize>,
 ) -> (App, RunReport) {
+    run_scene_showing(setup, steps, dt, compute_threads, &Progress::hidden())
+}
+
+/// [`run_scene_with_threads`], advancing `progress` a step at a time.
+pub fn run_scene_showing(
+    setup: &SceneSetup,
+    steps: u64,
+    dt: f64,
+    compute_threads: Option<usize>,
+    progress: &Progress,
+) -> (App, RunReport) {
     let mut app = headless_app_with_threads(dt, compute_threads);
     setup.apply(app.world_mut());
     let start = StateSummary::measure(app.world_mut());
-    let mut step_times = time_steps(&mut app, steps, |_| {});
+    let mut step_times = time_steps(&mut app, steps, |_| progress.advance(1));
     let end = StateSummary::measure(app.world_mut());
     let stats = app.world().resource::<SimStats>().clone();
     let clock = *app.world().resource::<SimClock>();

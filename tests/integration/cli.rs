@@ -376,3 +376,24 @@ fn the_bench_runs_every_case_in_its_children() {
         "Continuous"
     );
 }
+
+#[test]
+fn no_progress_bar_reaches_piped_output_and_quiet_is_accepted() {
+    // The bar is drawn on stderr only when stderr is a terminal; here both are pipes.
+    for quiet in [false, true] {
+        let mut args = vec!["run", "--scene", "assets/scenes/gas.ron", "--steps", "20"];
+        args.extend(["--balls", "100"]);
+        if quiet {
+            args.push("--quiet");
+        }
+        let out = ballpit_ok(&args);
+        assert!(
+            out.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8(out.stdout).unwrap().starts_with("balls"));
+    }
+    let soak = ballpit_ok(&["soak", "--scenes", "1", "--steps", "10", "--quiet"]);
+    assert!(soak.stderr.is_empty());
+}

@@ -24,6 +24,7 @@ use bevy::prelude::*;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::progress::Progress;
 use crate::headless::headless_app;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::grid::UniformGrid;
@@ -337,7 +338,8 @@ fn retune(world: &mut World, rng: &mut ChaCha8Rng) {
 
 /// Soaks scenes `first_seed..first_seed + scenes`, printing a line for each; returns how many
 /// failed.
-pub fn soak(first_seed: u64, scenes: u64, steps: u64, max_balls: usize) -> u64 {
+pub fn soak(first_seed: u64, scenes: u64, steps: u64, max_balls: usize, quiet: bool) -> u64 {
+    let progress = Progress::new(scenes, "scenes", quiet);
     let mut failed = 0;
     for seed in first_seed..first_seed.saturating_add(scenes) {
         let mut soak = SoakScene::draw(seed, max_balls);
@@ -354,16 +356,15 @@ pub fn soak(first_seed: u64, scenes: u64, steps: u64, max_balls: usize) -> u64 {
             ),
         };
         let seconds = started.elapsed().as_secs_f64();
-        match &outcome.failure {
+        failed += u64::from(outcome.failure.is_some());
+        progress.suspend(|| match &outcome.failure {
             None => println!(
                 "ok    {description}: {} steps in {seconds:.1} s",
                 outcome.steps
             ),
-            Some(failure) => {
-                failed += 1;
-                println!("FAIL  {description}: {failure}");
-            }
-        }
+            Some(failure) => println!("FAIL  {description}: {failure}"),
+        });
+        progress.advance(1);
     }
     failed
 }
