@@ -127,7 +127,7 @@ pub fn rest_and_sleep(
         dt,
     );
     sleep::wake_touched(state);
-    let load = solve(state, snapshot, &params, dt, &mut log);
+    let load = solve(state, snapshot, &params, (dt, rest_speed), &mut log);
     log.resting_wall_impulse += load + state.island_load.values().sum::<f64>() * dt;
     classify(state, snapshot, solver.collisions, rest_speed, dt);
     sleep::fall_asleep(state, &mut snapshot.velocities, dt);
@@ -139,9 +139,15 @@ pub fn rest_and_sleep(
 /// contain only the balls they move, and held ones may have been left outside.
 fn keep_inside(snapshot: &mut BallSnapshot, half: DVec2) {
     for circle in &mut snapshot.circles {
-        let limit = (half - DVec2::splat(circle.radius)).max(DVec2::ZERO);
-        circle.center = circle.center.clamp(-limit, limit);
+        circle.center = inside_arena(circle.center, circle.radius, half);
     }
+}
+
+/// `center` moved the least so that a ball of `radius` lies inside the arena `[-half, half]`
+/// (centred on an axis it is wider than).
+fn inside_arena(center: DVec2, radius: f64, half: DVec2) -> DVec2 {
+    let limit = (half - DVec2::splat(radius)).max(DVec2::ZERO);
+    center.clamp(-limit, limit)
 }
 
 /// Whether every ball sleeps, no hit disturbed one and nothing asks to wake them.
@@ -172,7 +178,7 @@ fn solve(
     state: &mut RestingState,
     snapshot: &mut BallSnapshot,
     params: &SimParams,
-    dt: f64,
+    (dt, rest_speed): (f64, f64),
     log: &mut StepLog,
 ) -> f64 {
     let solved =
@@ -197,7 +203,7 @@ fn solve(
         damping_ratio: CONTACT_DAMPING_RATIO,
         max_push_speed: MAX_PUSH_SPEED,
         restitution: params.restitution,
-        rest_speed: rest_speed(params, dt),
+        rest_speed,
     };
     soft_step(&mut bodies, &mut contacts, step);
     log_bounces(&contacts, snapshot, params, dt, log);
@@ -210,8 +216,7 @@ fn solve(
     for (index, body) in bodies.iter().enumerate() {
         if body.inverse_mass > 0.0 {
             let circle = &mut snapshot.circles[index];
-            let limit = (half - DVec2::splat(circle.radius)).max(DVec2::ZERO);
-            circle.center = (body.position + body.shift).clamp(-limit, limit);
+            circle.center = inside_arena(body.position + body.shift, circle.radius, half);
             // A safety net: no velocity leaves the solver faster than any ball may go.
             snapshot.velocities[index] = body.velocity.clamp_length_max(MAX_SPEED);
         }
