@@ -33,7 +33,7 @@ use crate::sim::measure::summary::{kinetic_energy, potential_energy};
 use crate::sim::params::{
     ARENA_SIDE_RANGE, DAMPING_SLIDER, GRAVITY_SLIDER, RESTITUTION_RANGE, TIME_SCALE_SLIDER,
 };
-use crate::sim::resting::contact_hertz;
+use crate::sim::resting::{Islands, contact_hertz};
 use crate::sim::{
     Ball, BroadPhase, CollisionMode, Position, Radius, Rest, RunControl, SceneSetup, SimParams,
     Solver, Velocity,
@@ -157,9 +157,16 @@ fn read_balls(world: &mut World, into: &mut Vec<(DVec2, DVec2, f64)>) {
 }
 
 /// The energy pushing out the overlaps among `balls` (position, velocity, radius) in a step
-/// of `dt` could add: each contact's spring energy, and each ball's weight times its deepest
-/// overlap.
-fn overlap_allowance(balls: &[(DVec2, DVec2, f64)], params: &SimParams, dt: f64) -> f64 {
+/// of `dt` could add: each contact's spring energy, and each ball's weight times the overlaps
+/// of its island (pushing out the bottom overlap of a column lifts the whole column). A wall,
+/// or a ball the solver holds as an anchor, does not give way, so a spring may carry the
+/// whole mass of the heavier awake ball.
+fn overlap_allowance(
+    balls: &[(DVec2, DVec2, f64)],
+    asleep: &[bool],
+    params: &SimParams,
+    dt: f64,
+) -> f64 {
     if params.gravity == DVec2::ZERO {
         return 0.0;
     }
@@ -172,22 +179,35 @@ fn overlap_allowance(balls: &[(DVec2, DVec2, f64)], params: &SimParams, dt: f64)
         &mut contacts,
     );
     let omega = 2.0 * std::f64::consts::PI * contact_hertz(dt);
-    let mass = |ball: u32| params.mass_model.mass(balls[ball as usize].2);
-    let mut deepest = vec![0.0_f64; balls.len()];
+    let awake_mass = |ball: u32| match asleep.get(ball as usize) {
+        Some(true) => 0.0,
+        _ => params.mass_model.mass(balls[ball as usize].2),
+    };
+    let spring = |mass: f64, depth: f64| 0.5 * mass * (omega * depth).powi(2);
+    let mut islands = Islands::new(balls.len());
+    let mut depths = vec![0.0; balls.len()];
     let mut springs = 0.0;
     for contact in &contacts {
         let depth = contact.geometry.depth;
-        for ball in [contact.a, contact.b] {
-            deepest[ball as usize] = deepest[ball as usize].max(depth);
-        }
-        let effective_mass = 1.0 / (1.0 / mass(contact.a) + 1.0 / mass(contact.b));
-        springs += 0.5 * effective_mass * (omega * depth).powi(2);
+        islands.join(contact.a, contact.b);
+        depths[contact.a as usize] += depth;
+        springs += spring(awake_mass(contact.a).max(awake_mass(contact.b)), depth);
     }
-    let weight = |radius: f64| params.mass_model.mass(radius) * params.gravity.length();
-    let lifts: f64 = balls
-        .iter()
-        .zip(deepest)
-        .map(|(&(_, _, r), depth)| weight(r) * depth)
+    let half = params.half_extents();
+    for (ball, &(position, _, radius)) in balls.iter().enumerate() {
+        let beyond = (position.abs() + DVec2::splat(radius) - half).max(DVec2::ZERO);
+        depths[ball] += beyond.x + beyond.y;
+        springs +=
+            spring(awake_mass(ball as u32), beyond.x) + spring(awake_mass(ball as u32), beyond.y);
+    }
+    let mut island_depth = vec![0.0; balls.len()];
+    for (ball, depth) in depths.iter().enumerate() {
+        island_depth[islands.root(ball as u32) as usize] += depth;
+    }
+    let lifts: f64 = (0..balls.len() as u32)
+        .map(|ball| {
+            awake_mass(ball) * params.gravity.length() * island_depth[islands.root(ball) as usize]
+        })
         .sum();
     springs + lifts
 }
@@ -259,7 +279,12 @@ pub fn soak_scene(soak: &SoakScene, setup: &SceneSetup, steps: u64) -> SoakOutco
             }
             let (before, asleep_before) = (balls.clone(), asleep.clone());
             let step_dt = soak.dt * app.world().resource::<RunControl>().time_scale;
-            let allowance = overlap_allowance(&balls, app.world().resource::<SimParams>(), step_dt);
+            let allowance = overlap_allowance(
+                &balls,
+                &asleep,
+                app.world().resource::<SimParams>(),
+                step_dt,
+            );
             app.update();
             done += 1;
             read_balls(app.world_mut(), &mut balls);

@@ -31,6 +31,7 @@
 
 mod constraint;
 mod contacts;
+mod islands;
 mod sleep;
 pub mod solver;
 mod state;
@@ -38,6 +39,7 @@ mod state;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+pub use self::islands::Islands;
 pub use self::sleep::{SLEEP_SPEED, TIME_TO_SLEEP};
 use self::solver::{Other, RestingContact, SoftStep, soft_step};
 use self::state::MotionKey;

@@ -4,6 +4,7 @@
 use bevy::math::DVec2;
 
 use super::contacts::NearPair;
+use super::islands::Islands;
 use super::state::RestingState;
 use crate::sim::ball::{Rest, RestState};
 
@@ -71,13 +72,13 @@ fn wake_islands(state: &mut RestingState, mut islands: Vec<u32>) {
 /// remembered so the pressure keeps counting it.
 pub fn fall_asleep(state: &mut RestingState, velocities: &mut [DVec2], dt: f64) {
     let count = state.rests.len();
-    let mut parent: Vec<u32> = (0..count as u32).collect();
+    let mut islands = Islands::new(count);
     let mut blocked = vec![false; count];
     let resting = |rest: &Rest| rest.state == RestState::Resting;
     for &NearPair { a, b, .. } in state.near.pairs.iter().filter(|pair| pair.touching) {
         let (ra, rb) = (&state.rests[a as usize], &state.rests[b as usize]);
         match (resting(ra), resting(rb)) {
-            (true, true) => union(&mut parent, a, b),
+            (true, true) => islands.join(a, b),
             (true, false) if !rb.is_asleep() => blocked[a as usize] = true,
             (false, true) if !ra.is_asleep() => blocked[b as usize] = true,
             _ => {}
@@ -88,7 +89,7 @@ pub fn fall_asleep(state: &mut RestingState, velocities: &mut [DVec2], dt: f64) 
     for index in 0..count {
         let rest = &state.rests[index];
         if resting(rest) && (blocked[index] || rest.still_for < TIME_TO_SLEEP) {
-            may_sleep[find(&mut parent, index as u32) as usize] = false;
+            may_sleep[islands.root(index as u32) as usize] = false;
         }
     }
     let mut island_of_root: Vec<Option<u32>> = vec![None; count];
@@ -96,7 +97,7 @@ pub fn fall_asleep(state: &mut RestingState, velocities: &mut [DVec2], dt: f64) 
         if !resting(&state.rests[index]) {
             continue;
         }
-        let root = find(&mut parent, index as u32) as usize;
+        let root = islands.root(index as u32) as usize;
         if !may_sleep[root] {
             continue;
         }
@@ -114,22 +115,5 @@ pub fn fall_asleep(state: &mut RestingState, velocities: &mut [DVec2], dt: f64) 
             .unwrap_or(0.0)
             / dt;
         *state.island_load.entry(island).or_insert(0.0) += load;
-    }
-}
-
-fn find(parent: &mut [u32], mut node: u32) -> u32 {
-    while parent[node as usize] != node {
-        let grandparent = parent[parent[node as usize] as usize];
-        parent[node as usize] = grandparent;
-        node = grandparent;
-    }
-    node
-}
-
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (root_a, root_b) = (find(parent, a), find(parent, b));
-    if root_a != root_b {
-        let (low, high) = (root_a.min(root_b), root_a.max(root_b));
-        parent[high as usize] = low;
     }
 }

@@ -94,6 +94,9 @@ pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: Sof
     }
 }
 
+/// Gauss–Seidel passes over the bounces when more than one contact bounces in a step.
+const RESTITUTION_PASSES: usize = 8;
+
 /// A body the solver has no slot for: an anchor no contact touches.
 const NO_SLOT: u32 = u32::MAX;
 
@@ -278,30 +281,49 @@ impl Work {
 
     /// Contacts that closed at `rest_speed` or faster when the step began, and that the
     /// solver had to hold, bounce: their normal speed becomes `-restitution` times that
-    /// closing speed.
+    /// closing speed. A ball struck on two sides at once shares its bounces: the passes
+    /// converge on impulses that meet every contact's target together (each bounce impulse
+    /// non-negative), where one pass would let the last contact's push add to the first's and
+    /// gain energy.
     fn apply_restitution(
         &mut self,
         contacts: &mut [RestingContact],
         restitution: f64,
         rest_speed: f64,
     ) {
-        for (contact, link) in contacts.iter_mut().zip(&mut self.links) {
-            if restitution == 0.0
-                || !contact.may_bounce
-                || contact.closing_velocity > -rest_speed
-                || contact.step_impulse == 0.0
-                || link.mass == 0.0
-            {
-                continue;
+        if restitution == 0.0 {
+            return;
+        }
+        let bouncing: Vec<usize> = (contacts.iter().zip(&self.links).enumerate())
+            .filter(|(_, (contact, link))| {
+                contact.may_bounce
+                    && contact.closing_velocity <= -rest_speed
+                    && contact.step_impulse != 0.0
+                    && link.mass != 0.0
+            })
+            .map(|(index, _)| index)
+            .collect();
+        let mut bounce = vec![0.0; bouncing.len()];
+        let passes = if bouncing.len() > 1 {
+            RESTITUTION_PASSES
+        } else {
+            1
+        };
+        for _ in 0..passes {
+            for (bounce, &index) in bounce.iter_mut().zip(&bouncing) {
+                let link = &mut self.links[index];
+                let normal_speed = Self::normal_velocity(&self.motion, link);
+                let target = -restitution * contacts[index].closing_velocity;
+                let total = (*bounce - (normal_speed - target) * link.mass).max(0.0);
+                let applied = total - *bounce;
+                *bounce = total;
+                link.impulse += applied;
+                Self::apply_impulse(&mut self.motion, link, applied);
             }
-            let normal_speed = Self::normal_velocity(&self.motion, link);
-            let change = -(normal_speed + restitution * contact.closing_velocity) * link.mass;
-            let total = (link.impulse + change).max(0.0);
-            let applied = total - link.impulse;
-            link.impulse = total;
-            contact.step_impulse += applied;
-            contact.bounced = true;
-            Self::apply_impulse(&mut self.motion, link, applied);
+        }
+        for (bounce, &index) in bounce.iter().zip(&bouncing) {
+            contacts[index].step_impulse += bounce;
+            contacts[index].bounced = true;
         }
     }
 }
