@@ -11,9 +11,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
+use crate::commands::observe::dump::StateDump;
+use crate::commands::observe::{ObserveRequest, Observers};
 use crate::commands::pile::{format_pile_table, run_pile};
 use crate::commands::progress::Progress;
-use crate::commands::run::{StateDump, run_scene_showing};
+use crate::commands::run::run_scene_showing;
 use crate::commands::soak::soak;
 use crate::headless::DEFAULT_DT;
 use crate::sim::params::MAX_BALLS;
@@ -169,6 +171,17 @@ pub struct RunArgs {
     /// No progress bar (it is drawn on stderr only when stderr is a terminal).
     #[arg(long)]
     pub quiet: bool,
+    /// Write the time series to this CSV file: a row at step 0, every `--every` steps and at
+    /// the last step (the README lists the columns).
+    #[arg(long, value_name = "OUT.csv")]
+    pub series: Option<PathBuf>,
+    /// Write the balls' motion to this extended XYZ file (ASE, OVITO): a frame at step 0,
+    /// every `--every` steps and at the last step.
+    #[arg(long, value_name = "OUT.xyz")]
+    pub trajectory: Option<PathBuf>,
+    /// Steps between the series' rows and the trajectory's frames, at least 1.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: u64,
 }
 
 fn parse_step_seconds(text: &str) -> Result<f64, String> {
@@ -273,9 +286,25 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     override_scene(&mut scene, &origin, args.collisions, args.balls, args.seed)?;
     let setup = scene.build(&origin)?;
     let threads = args.threads.map(|n| n as usize);
+    // A file that cannot be written, or a trajectory too large, fails now, before any step.
+    let mut observers = Observers::open(ObserveRequest {
+        series: args.series.as_deref(),
+        trajectory: args.trajectory.as_deref(),
+        every: args.every,
+        balls: setup.balls.len(),
+        steps: args.steps,
+    })?;
     let progress = Progress::new(args.steps, "steps", args.quiet);
-    let (mut app, report) = run_scene_showing(&setup, args.steps, args.dt, threads, &progress);
+    let (mut app, report) = run_scene_showing(
+        &setup,
+        args.steps,
+        args.dt,
+        threads,
+        &progress,
+        &mut observers,
+    );
     drop(progress);
+    observers.finish()?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {

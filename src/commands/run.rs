@@ -1,17 +1,15 @@
 //! `ballpit run`: a scene stepped a fixed number of times in a [`headless_app`](crate::headless::headless_app), measured
-//! into a [`RunReport`]; optionally every ball's final state in a [`StateDump`]. Used by the
-//! command line and the tests.
+//! into a [`RunReport`], with [`Observers`] recording along the way (the series and the
+//! trajectory). Used by the command line and the tests.
 
 use bevy::prelude::*;
 use serde::Serialize;
 
+use super::observe::Observers;
 use super::progress::Progress;
 use crate::headless::{headless_app_with_threads, mean, median, time_steps};
 use crate::sim::measure::gas::SpeedHistogram;
-use crate::sim::{
-    Ball, BallId, Position, Radius, SceneSetup, SimClock, SimParams, SimStats, StateSummary,
-    Velocity,
-};
+use crate::sim::{SceneSetup, SimClock, SimParams, SimStats, StateSummary};
 
 /// What `ballpit run` prints. Units: pixels, seconds, mass from the mass model.
 #[derive(Clone, Debug, Serialize)]
@@ -136,21 +134,47 @@ pub fn run_scene_with_threads(
     dt: f64,
     compute_threads: Option<usize>,
 ) -> (App, RunReport) {
-    run_scene_showing(setup, steps, dt, compute_threads, &Progress::hidden())
+    run_scene_showing(
+        setup,
+        steps,
+        dt,
+        compute_threads,
+        &Progress::hidden(),
+        &mut Observers::none(),
+    )
 }
 
-/// [`run_scene_with_threads`], advancing `progress` a step at a time.
+/// [`run_scene_with_threads`], advancing `progress` a step at a time and letting
+/// `observers` record at step 0, every `observers.every` steps and at the last.
 pub fn run_scene_showing(
     setup: &SceneSetup,
     steps: u64,
     dt: f64,
     compute_threads: Option<usize>,
     progress: &Progress,
+    observers: &mut Observers,
 ) -> (App, RunReport) {
     let mut app = headless_app_with_threads(dt, compute_threads);
     setup.apply(app.world_mut());
     let start = StateSummary::measure(app.world_mut());
-    let mut step_times = time_steps(&mut app, steps, |_| progress.advance(1));
+    let chunk = if observers.is_empty() {
+        steps.max(1)
+    } else {
+        observers.every
+    };
+    let mut step_times = Vec::with_capacity(steps as usize);
+    loop {
+        if !observers.is_empty() {
+            observers.record(app.world_mut());
+        }
+        let left = steps - step_times.len() as u64;
+        if left == 0 {
+            break;
+        }
+        step_times.extend(time_steps(&mut app, chunk.min(left), |_| {
+            progress.advance(1)
+        }));
+    }
     let end = StateSummary::measure(app.world_mut());
     let stats = app.world().resource::<SimStats>().clone();
     let clock = *app.world().resource::<SimClock>();
@@ -196,45 +220,6 @@ fn relative_change(start: f64, end: f64) -> f64 {
         0.0
     } else {
         (end - start) / start.abs()
-    }
-}
-
-/// One ball in a `--dump` file.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct DumpedBall {
-    pub id: u32,
-    pub x: f64,
-    pub y: f64,
-    pub vx: f64,
-    pub vy: f64,
-    pub r: f64,
-    pub m: f64,
-}
-
-/// The `--dump` file: every ball's final state, in id order.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct StateDump {
-    pub balls: Vec<DumpedBall>,
-}
-
-impl StateDump {
-    pub fn capture(world: &mut World) -> StateDump {
-        let mass_model = world.resource::<SimParams>().mass_model;
-        let mut balls: Vec<DumpedBall> = world
-            .query_filtered::<(&BallId, &Position, &Velocity, &Radius), With<Ball>>()
-            .iter(world)
-            .map(|(id, position, velocity, radius)| DumpedBall {
-                id: id.0,
-                x: position.x,
-                y: position.y,
-                vx: velocity.x,
-                vy: velocity.y,
-                r: radius.0,
-                m: mass_model.mass(radius.0),
-            })
-            .collect();
-        balls.sort_by_key(|ball| ball.id);
-        StateDump { balls }
     }
 }
 

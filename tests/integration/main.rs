@@ -8,6 +8,7 @@ mod continuous;
 #[cfg(feature = "gui")]
 mod game;
 mod house;
+mod observe;
 mod physics;
 mod piles;
 mod scenes;
