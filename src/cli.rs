@@ -51,13 +51,17 @@ pub struct PlayArgs {
     /// Save a PNG of the window after `--frames` frames, then exit.
     #[arg(long, value_name = "OUT.png")]
     pub screenshot: Option<PathBuf>,
+    /// Record `--frames` frames of the window (25 a second of game time) as an animated
+    /// GIF, then exit.
+    #[arg(long, value_name = "OUT.gif", conflicts_with = "screenshot")]
+    pub record: Option<PathBuf>,
     /// Override the scene's `generate.count`.
     #[arg(long)]
     pub balls: Option<usize>,
     /// Override the scene's `generate.seed`.
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Frames to run before the screenshot.
+    /// Frames to run before the screenshot, or to record.
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
     /// Collision mode, overriding the scene's.
@@ -258,10 +262,17 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
     // Refuse a bad scene here, with exit code 1, rather than in the window.
     let arena = file.build(&origin)?.params.arena_size.as_vec2();
     let screenshot = args.screenshot.map(|path| (path, args.frames));
+    if let Some(path) = &args.record {
+        // An unwritable recording fails now, not after the frames are played.
+        std::fs::File::create(path)
+            .map_err(|e| format!("{}: cannot write the recording: {e}", path.display()))?;
+    }
+    let record = args.record.map(|path| (path, args.frames));
     match play(PlayOptions {
         scene: CurrentScene { file, origin },
         arena,
         screenshot,
+        record,
         paused: args.paused,
     }) {
         bevy::app::AppExit::Success => Ok(()),

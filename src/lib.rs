@@ -26,6 +26,8 @@ pub mod diagnostics;
 #[cfg(feature = "gui")]
 pub mod play;
 #[cfg(feature = "gui")]
+pub mod record;
+#[cfg(feature = "gui")]
 pub mod render;
 #[cfg(feature = "gui")]
 pub mod ui;

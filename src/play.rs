@@ -1,6 +1,7 @@
 //! The windowed toy put together: default plugins, the simulation, the toy's shared state
 //! ([`app`]), its rendering, its UI and frame diagnostics; optionally a
-//! screenshot after a number of frames (for the README and for checks under Xvfb).
+//! screenshot after a number of frames, or a recording of them ([`record`](crate::record)),
+//! for the README and for checks under Xvfb.
 
 use std::path::PathBuf;
 
@@ -11,6 +12,7 @@ use bevy::window::WindowResolution;
 
 use crate::app::scenes::CurrentScene;
 use crate::app::view::{PANEL_WIDTH, fit_window};
+use crate::record::{RecordPlan, start_recording};
 use crate::sim::params::DEFAULT_STEP_RATE;
 use crate::sim::{Ball, RunControl, SimPlugin};
 use crate::{app, diagnostics, render, ui};
@@ -22,6 +24,8 @@ pub struct PlayOptions {
     pub arena: Vec2,
     /// Save a PNG of the window after `frames` frames, then exit.
     pub screenshot: Option<(PathBuf, u32)>,
+    /// Record `frames` frames of the window as a GIF, then exit.
+    pub record: Option<(PathBuf, u32)>,
     /// Start paused (Space or the Pause button runs it).
     pub paused: bool,
 }
@@ -49,6 +53,9 @@ pub fn play(options: PlayOptions) -> AppExit {
             requested_at: None,
         })
         .add_systems(Update, take_screenshot_and_exit);
+    }
+    if let Some((path, frames)) = options.record {
+        start_recording(&mut app, RecordPlan::new(path, frames));
     }
     app.run()
 }

@@ -1,6 +1,6 @@
 //! `ballpit run --series/--trajectory/--every`: the CSV parsed and checked against the report,
 //! the trajectory read by the extended XYZ specification (frames counted, the last one equal
-//! to `--dump`), and bad requests refused before any step runs.
+//! to `--dump`), and bad requests refused before any step runs; `--record`'s bad requests.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -277,4 +277,20 @@ fn bad_requests_are_refused_before_the_run_starts() {
     );
     assert!(!huge.exists());
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_recording_cannot_also_be_a_screenshot_and_an_unwritable_one_fails_before_the_window() {
+    let out = ballpit(&["--record", "a.gif", "--screenshot", "b.png"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = ballpit(&["--record", "no/such/folder/a.gif", "--frames", "5"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // With the toy built in, the file is refused before a window opens; without, the window.
+    let expected = if cfg!(feature = "gui") {
+        "error: no/such/folder/a.gif: cannot write the recording"
+    } else {
+        "without the `gui` feature"
+    };
+    assert!(stderr.contains(expected), "{stderr}");
 }
