@@ -14,7 +14,7 @@ use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_ca
 use crate::commands::observe::dump::StateDump;
 use crate::commands::observe::{ObserveRequest, Observers};
 use crate::commands::pile::{format_pile_table, run_pile};
-use crate::commands::progress::Progress;
+use crate::commands::progress::{Progress, print_out};
 use crate::commands::run::run_scene_showing;
 use crate::commands::soak::soak;
 use crate::headless::DEFAULT_DT;
@@ -317,9 +317,9 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
     drop(progress);
     observers.finish()?;
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        print_out(&format!("{}\n", serde_json::to_string(&report)?));
     } else {
-        print!("{}", report.to_text());
+        print_out(&report.to_text());
     }
     if let Some(path) = args.dump {
         let dump = StateDump::capture(app.world_mut());
@@ -370,9 +370,9 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     }
     drop(progress);
     if args.json {
-        println!("{}", serde_json::to_string(&rows)?);
+        print_out(&format!("{}\n", serde_json::to_string(&rows)?));
     } else {
-        print!("{}", format_table(&rows));
+        print_out(&format_table(&rows));
     }
     Ok(())
 }
@@ -389,9 +389,9 @@ fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
     }
     drop(progress);
     if args.json {
-        println!("{}", serde_json::to_string(&rows)?);
+        print_out(&format!("{}\n", serde_json::to_string(&rows)?));
     } else {
-        print!("{}", format_pile_table(&rows));
+        print_out(&format_pile_table(&rows));
     }
     Ok(())
 }
@@ -407,7 +407,7 @@ fn run_soak(args: SoakArgs) -> Result<(), Box<dyn Error>> {
     if failed > 0 {
         return Err(format!("{failed} of {} scenes failed", args.scenes).into());
     }
-    println!("all {} scenes passed", args.scenes);
+    print_out(&format!("all {} scenes passed\n", args.scenes));
     Ok(())
 }
 
@@ -418,10 +418,8 @@ fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
         broad_phase: args.broad_phase,
         collisions: args.collisions,
     };
-    println!(
-        "{}",
-        serde_json::to_string(&run_case(case, args.threads as usize)?)?
-    );
+    let row = serde_json::to_string(&run_case(case, args.threads as usize)?)?;
+    print_out(&format!("{row}\n"));
     Ok(())
 }
 

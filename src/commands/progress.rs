@@ -1,10 +1,19 @@
 //! A progress bar for the long headless commands (`run`, `soak`, `bench`): work done, its
 //! rate and the time left, drawn on stderr, and only when stderr is a terminal, so piped
 //! output and `--json` stay exactly as they are; `--quiet` silences it. `indicatif` draws it.
+//! Also [`print_out`], how the commands write their results to stdout: a reader that has
+//! gone (`ballpit run ... | head`) ends the printing, not the command.
 
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// Writes `text` to stdout. A closed pipe, or any other failure to print, is not an error
+/// of the command: what it writes to files (a dump, a series) still gets written.
+pub fn print_out(text: &str) {
+    use std::io::Write;
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+}
 
 /// The bar, or nothing when it is not shown.
 pub struct Progress(Option<ProgressBar>);

@@ -397,3 +397,37 @@ fn no_progress_bar_reaches_piped_output_and_quiet_is_accepted() {
     let soak = ballpit_ok(&["soak", "--scenes", "1", "--steps", "10", "--quiet"]);
     assert!(soak.stderr.is_empty());
 }
+
+#[test]
+fn a_reader_that_goes_away_ends_the_printing_not_the_run() {
+    let dir = std::env::temp_dir().join(format!("ballpit-pipe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dump = dir.join("state.json");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ballpit"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args([
+            "run",
+            "--scene",
+            "assets/scenes/gas.ron",
+            "--steps",
+            "30",
+            "--dump",
+        ])
+        .arg(&dump)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Like `| head -0`: the reader is gone before the report is printed.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        std::fs::read_to_string(&dump)
+            .unwrap()
+            .contains("\"balls\"")
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -24,7 +24,7 @@ use bevy::prelude::*;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::progress::Progress;
+use super::progress::{Progress, print_out};
 use crate::headless::headless_app;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::grid::UniformGrid;
@@ -383,11 +383,11 @@ pub fn soak(first_seed: u64, scenes: u64, steps: u64, max_balls: usize, quiet: b
         let seconds = started.elapsed().as_secs_f64();
         failed += u64::from(outcome.failure.is_some());
         progress.suspend(|| match &outcome.failure {
-            None => println!(
-                "ok    {description}: {} steps in {seconds:.1} s",
+            None => print_out(&format!(
+                "ok    {description}: {} steps in {seconds:.1} s\n",
                 outcome.steps
-            ),
-            Some(failure) => println!("FAIL  {description}: {failure}"),
+            )),
+            Some(failure) => print_out(&format!("FAIL  {description}: {failure}\n")),
         });
         progress.advance(1);
     }
