@@ -263,8 +263,21 @@ fn run_window(args: PlayArgs) -> Result<(), Box<dyn Error>> {
     let arena = file.build(&origin)?.params.arena_size.as_vec2();
     let screenshot = args.screenshot.map(|path| (path, args.frames));
     if let Some(path) = &args.record {
-        // An unwritable recording fails now, not after the frames are played.
-        std::fs::File::create(path)
+        use crate::record::MAX_RECORD_FRAMES;
+        if args.frames > MAX_RECORD_FRAMES {
+            return Err(format!(
+                "a recording keeps its frames in memory: at most {MAX_RECORD_FRAMES} (30 s), \
+                 not {}",
+                args.frames
+            )
+            .into());
+        }
+        // An unwritable recording fails now, not after the frames are played (and an
+        // existing file stays as it is until the new one is written).
+        std::fs::OpenOptions::new()
+            .append(true)
+            .create(true)
+            .open(path)
             .map_err(|e| format!("{}: cannot write the recording: {e}", path.display()))?;
     }
     let record = args.record.map(|path| (path, args.frames));
@@ -315,19 +328,20 @@ fn run_headless(args: RunArgs) -> Result<(), Box<dyn Error>> {
         &mut observers,
     );
     drop(progress);
-    observers.finish()?;
-    if args.json {
-        print_out(&format!("{}\n", serde_json::to_string(&report)?));
+    // The report and the dump come first: a series that failed mid-run loses neither.
+    let printed = if args.json {
+        print_out(&format!("{}\n", serde_json::to_string(&report)?))
     } else {
-        print_out(&report.to_text());
-    }
+        print_out(&report.to_text())
+    };
     if let Some(path) = args.dump {
         let dump = StateDump::capture(app.world_mut());
         let text = serde_json::to_string(&dump)?;
         std::fs::write(&path, text)
             .map_err(|e| format!("{}: cannot write the dump: {e}", path.display()))?;
     }
-    Ok(())
+    observers.finish()?;
+    Ok(printed?)
 }
 
 fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
@@ -370,9 +384,9 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     }
     drop(progress);
     if args.json {
-        print_out(&format!("{}\n", serde_json::to_string(&rows)?));
+        print_out(&format!("{}\n", serde_json::to_string(&rows)?))?;
     } else {
-        print_out(&format_table(&rows));
+        print_out(&format_table(&rows))?;
     }
     Ok(())
 }
@@ -389,9 +403,9 @@ fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
     }
     drop(progress);
     if args.json {
-        print_out(&format!("{}\n", serde_json::to_string(&rows)?));
+        print_out(&format!("{}\n", serde_json::to_string(&rows)?))?;
     } else {
-        print_out(&format_pile_table(&rows));
+        print_out(&format_pile_table(&rows))?;
     }
     Ok(())
 }
@@ -407,7 +421,7 @@ fn run_soak(args: SoakArgs) -> Result<(), Box<dyn Error>> {
     if failed > 0 {
         return Err(format!("{failed} of {} scenes failed", args.scenes).into());
     }
-    print_out(&format!("all {} scenes passed\n", args.scenes));
+    print_out(&format!("all {} scenes passed\n", args.scenes))?;
     Ok(())
 }
 
@@ -419,7 +433,7 @@ fn run_bench_one(args: BenchOneArgs) -> Result<(), Box<dyn Error>> {
         collisions: args.collisions,
     };
     let row = serde_json::to_string(&run_case(case, args.threads as usize)?)?;
-    print_out(&format!("{row}\n"));
+    print_out(&format!("{row}\n"))?;
     Ok(())
 }
 

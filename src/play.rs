@@ -4,6 +4,7 @@
 //! for the README and for checks under Xvfb.
 
 use std::path::PathBuf;
+use std::sync::atomic::Ordering;
 
 use bevy::diagnostic::DiagnosticsStore;
 use bevy::prelude::*;
@@ -38,6 +39,8 @@ pub fn play(options: PlayOptions) -> AppExit {
         primary_window: Some(Window {
             title: "ballpit".into(),
             resolution: WindowResolution::new(window.x as u32, window.y as u32),
+            // A recording's frames must all be one size.
+            resizable: options.record.is_none(),
             ..default()
         }),
         ..default()
@@ -54,10 +57,16 @@ pub fn play(options: PlayOptions) -> AppExit {
         })
         .add_systems(Update, take_screenshot_and_exit);
     }
-    if let Some((path, frames)) = options.record {
-        start_recording(&mut app, RecordPlan::new(path, frames));
+    let recorded = options
+        .record
+        .map(|(path, frames)| start_recording(&mut app, RecordPlan::new(path, frames)));
+    match app.run() {
+        AppExit::Success if recorded.is_some_and(|written| !written.load(Ordering::Acquire)) => {
+            error!("the window closed before the recording was written");
+            AppExit::error()
+        }
+        exit => exit,
     }
-    app.run()
 }
 
 /// The whole toy but the window and rendering backends: the simulation at 60 steps per

@@ -5,12 +5,16 @@
 //! exactly [`RECORD_FRAME`] of time whatever the machine's speed, so the GIF plays at the
 //! toy's real pace: 25 frames a second.
 //!
+//! At most [`MAX_RECORD_FRAMES`] frames, held in memory until encoded; the window cannot
+//! be resized meanwhile, and closing it early is an error ([`RecordPlan::written`]).
+//!
 //! The encoder is pure and unit-tested: one palette, the recording's own colours if it has
 //! at most 255, else 255 learnt from a few frames (NeuQuant), and after the first frame only the box of pixels that changed, with unchanged
 //! pixels in it transparent, which is what keeps a few seconds of the toy small.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -22,6 +26,8 @@ use bevy::time::TimeUpdateStrategy;
 pub const RECORD_FRAME: Duration = Duration::from_millis(40);
 /// The GIF's frame delay, hundredths of a second: [`RECORD_FRAME`].
 const DELAY_CENTISECONDS: u16 = 4;
+/// The most frames one recording keeps (30 s; they are held in memory until encoded).
+pub const MAX_RECORD_FRAMES: u32 = 750;
 /// Frames recorded wider than this are shrunk by a whole factor to fit.
 pub const MAX_RECORD_WIDTH: u32 = 800;
 /// Frames run before recording starts (the window and panel settling).
@@ -80,6 +86,9 @@ pub fn shrink_factor(width: u32) -> u32 {
 pub fn encode_gif(frames: &[RgbaFrame], delay_cs: u16) -> Result<Vec<u8>, String> {
     let first = frames.first().ok_or("no frames to encode")?;
     let (width, height) = (first.width, first.height);
+    if width == 0 || height == 0 {
+        return Err(format!("a {width} x {height} px frame has nothing to show"));
+    }
     if frames
         .iter()
         .any(|f| (f.width, f.height) != (width, height))
@@ -207,6 +216,9 @@ struct Patch {
 /// The box of `indices` that differs from `previous` (the whole frame if there is none),
 /// with unchanged pixels inside it [`TRANSPARENT`]; `None` if nothing changed.
 fn changed_patch(indices: &[u8], previous: Option<&[u8]>, width: u32) -> Option<Patch> {
+    if width == 0 {
+        return None;
+    }
     let height = indices.len() as u32 / width;
     let Some(previous) = previous else {
         return Some(Patch {
@@ -252,6 +264,10 @@ pub struct RecordPlan {
     captured: Arc<Mutex<Vec<Option<RgbaFrame>>>>,
     requested: u32,
     last_request: u32,
+    /// Set once the GIF is written: a window closed before then recorded nothing.
+    pub written: Arc<AtomicBool>,
+    /// Encoded (or failed): the toy is on its way out.
+    finished: bool,
 }
 
 impl RecordPlan {
@@ -262,15 +278,20 @@ impl RecordPlan {
             captured: Arc::new(Mutex::new(vec![None; frames as usize])),
             requested: 0,
             last_request: 0,
+            written: Arc::new(AtomicBool::new(false)),
+            finished: false,
         }
     }
 }
 
-/// Records the window into `plan.path` and exits (see the module header).
-pub fn start_recording(app: &mut App, plan: RecordPlan) {
+/// Records the window into `plan.path` and exits (see the module header). Returns the flag
+/// that says whether the GIF was written.
+pub fn start_recording(app: &mut App, plan: RecordPlan) -> Arc<AtomicBool> {
+    let written = plan.written.clone();
     app.insert_resource(plan)
         .insert_resource(TimeUpdateStrategy::ManualDuration(RECORD_FRAME))
         .add_systems(Update, record_and_exit);
+    written
 }
 
 fn record_and_exit(
@@ -284,8 +305,12 @@ fn record_and_exit(
         let (slot, captured) = (plan.requested as usize, plan.captured.clone());
         commands.spawn(Screenshot::primary_window()).observe(
             move |screenshot: On<ScreenshotCaptured>| {
-                let Ok(image) = screenshot.image.clone().try_into_dynamic() else {
-                    return;
+                let image = match screenshot.image.clone().try_into_dynamic() {
+                    Ok(image) => image,
+                    Err(error) => {
+                        error!("recorded frame {slot} cannot be read: {error}");
+                        return;
+                    }
                 };
                 let image = image.to_rgba8();
                 let frame = RgbaFrame {
@@ -303,12 +328,17 @@ fn record_and_exit(
         plan.last_request = *frame;
         return;
     }
-    if plan.requested < plan.frames {
+    if plan.requested < plan.frames || plan.finished {
         return;
     }
-    let frames: Option<Vec<RgbaFrame>> = match plan.captured.lock() {
-        Ok(captured) => captured.iter().cloned().collect(),
-        Err(_) => None,
+    let frames = match plan.captured.lock() {
+        Ok(mut captured) if captured.iter().all(Option::is_some) => Some(
+            std::mem::take(&mut *captured)
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>(),
+        ),
+        _ => None,
     };
     match frames {
         Some(frames) => {
@@ -316,7 +346,8 @@ fn record_and_exit(
                 .and_then(|gif| std::fs::write(&plan.path, gif).map_err(|e| e.to_string()));
             match written {
                 Ok(()) => {
-                    println!(
+                    plan.written.store(true, Ordering::Release);
+                    info!(
                         "recorded {} frames to {}",
                         frames.len(),
                         plan.path.display()
@@ -328,6 +359,7 @@ fn record_and_exit(
                     exit.write(AppExit::error());
                 }
             }
+            plan.finished = true;
         }
         None if *frame >= plan.last_request + FRAMES_TO_GIVE_UP => {
             error!("the recording {} lost frames", plan.path.display());

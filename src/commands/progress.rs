@@ -2,17 +2,22 @@
 //! rate and the time left, drawn on stderr, and only when stderr is a terminal, so piped
 //! output and `--json` stay exactly as they are; `--quiet` silences it. `indicatif` draws it.
 //! Also [`print_out`], how the commands write their results to stdout: a reader that has
-//! gone (`ballpit run ... | head`) ends the printing, not the command.
+//! gone (`ballpit run ... | head`) ends the printing, not the command; a full disk is an
+//! error.
 
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// Writes `text` to stdout. A closed pipe, or any other failure to print, is not an error
-/// of the command: what it writes to files (a dump, a series) still gets written.
-pub fn print_out(text: &str) {
+/// Writes `text` to stdout. A closed pipe is not an error of the command (what it writes
+/// to files, a dump or a series, still gets written); any other failure (a full disk) is.
+pub fn print_out(text: &str) -> std::io::Result<()> {
     use std::io::Write;
-    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(error) if error.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other,
+    }
 }
 
 /// The bar, or nothing when it is not shown.

@@ -216,6 +216,7 @@ fn check_trajectory(report: &serde_json::Value, trajectory: &str, dump: &str) {
     }
     let dump: serde_json::Value = serde_json::from_str(dump).unwrap();
     let last = &frames[3];
+    assert_eq!(dump["balls"].as_array().unwrap().len(), last.rows.len());
     for (row, ball) in last.rows.iter().zip(dump["balls"].as_array().unwrap()) {
         let number = |column: usize| row[column].parse::<f64>().unwrap();
         for (column, key) in [(1, "x"), (2, "y"), (4, "vx"), (5, "vy"), (7, "r"), (8, "m")] {
@@ -272,7 +273,7 @@ fn bad_requests_are_refused_before_the_run_starts() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("a trajectory of 201 frames of 1000000 balls could reach 39.6 GB"),
+        stderr.contains("a trajectory of 201 frames of 1000000 balls could reach 33.6 GB"),
         "{stderr}"
     );
     assert!(!huge.exists());
@@ -283,6 +284,13 @@ fn bad_requests_are_refused_before_the_run_starts() {
 fn a_recording_cannot_also_be_a_screenshot_and_an_unwritable_one_fails_before_the_window() {
     let out = ballpit(&["--record", "a.gif", "--screenshot", "b.png"]);
     assert_eq!(out.status.code(), Some(2));
+    let out = ballpit(&["--record", "long.gif", "--frames", "751"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        !std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("long.gif")
+            .exists()
+    );
     let out = ballpit(&["--record", "no/such/folder/a.gif", "--frames", "5"]);
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -293,4 +301,48 @@ fn a_recording_cannot_also_be_a_screenshot_and_an_unwritable_one_fails_before_th
         "without the `gui` feature"
     };
     assert!(stderr.contains(expected), "{stderr}");
+}
+
+#[test]
+fn a_run_as_long_as_a_whole_number_of_intervals_records_each_step_once() {
+    let dir = scratch("observe-whole");
+    let series = dir.join("series.csv");
+    let out = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/head_on.ron",
+        "--steps",
+        "30",
+        "--every",
+        "15",
+        "--series",
+        series.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&series).unwrap();
+    let steps: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .map(|row| row.split(',').next().unwrap())
+        .collect();
+    assert_eq!(steps, ["0", "15", "30"]);
+    // A refused trajectory leaves no series behind.
+    let refused = ballpit(&[
+        "run",
+        "--scene",
+        "assets/scenes/head_on.ron",
+        "--steps",
+        "1",
+        "--series",
+        dir.join("kept.csv").to_str().unwrap(),
+        "--trajectory",
+        "no/such/folder/t.xyz",
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(!dir.join("kept.csv").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

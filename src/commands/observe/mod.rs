@@ -46,17 +46,25 @@ impl Observers {
         }
     }
 
-    /// Opens the files asked for: fails, naming the file, before any step runs.
+    /// Opens the files asked for: fails, naming the file, before any step runs. A refused
+    /// trajectory size creates no file, and a file that cannot be created leaves none of the
+    /// others behind.
     pub fn open(request: ObserveRequest) -> Result<Self, String> {
         let every = request.every.max(1);
+        let frames = records(request.steps, every);
+        if let Some(path) = request.trajectory {
+            trajectory::check_size(path, request.balls, frames)?;
+        }
+        let series = request.series.map(Series::create).transpose()?;
         let trajectory = request
             .trajectory
-            .map(|path| {
-                let frames = records(request.steps, every);
-                Trajectory::create(path, request.balls, frames)
-            })
-            .transpose()?;
-        let series = request.series.map(Series::create).transpose()?;
+            .map(|path| Trajectory::create(path, request.balls, frames))
+            .transpose()
+            .inspect_err(|_| {
+                if let Some(series) = request.series {
+                    let _ = std::fs::remove_file(series);
+                }
+            })?;
         Ok(Self {
             every,
             series,
