@@ -28,7 +28,7 @@ use crate::sim::{SimClock, SimParams};
 /// The largest trajectory a run may write, bytes.
 pub const MAX_TRAJECTORY_BYTES: u64 = 2_000_000_000;
 /// The longest a number is written, characters (see [`number`]).
-const MAX_NUMBER: u64 = 24;
+pub const MAX_NUMBER: u64 = 24;
 /// What a ball's line takes at most, bytes: `X`, six numbers, two zeros, a 10-digit id,
 /// nine spaces and the newline.
 pub const MAX_BYTES_PER_BALL: u64 = 1 + 6 * MAX_NUMBER + 2 + 10 + 9 + 1;
