@@ -78,9 +78,12 @@ pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: Sof
         work.solve_contacts(h, Some((softness, step.max_push_speed)));
         work.integrate_positions(h);
         work.relax_contacts(h);
-        for (contact, link) in contacts.iter_mut().zip(&work.links) {
-            contact.step_impulse += link.impulse;
+        for link in &mut work.links {
+            link.step_impulse += link.impulse;
         }
+    }
+    for (contact, link) in contacts.iter_mut().zip(&work.links) {
+        contact.step_impulse = link.step_impulse;
     }
     work.apply_restitution(contacts, step.restitution, step.rest_speed);
     for (contact, link) in contacts.iter_mut().zip(&work.links) {
@@ -131,6 +134,8 @@ struct Link {
     normal: DVec2,
     separation: f64,
     impulse: f64,
+    /// The impulse summed over the step's substeps.
+    step_impulse: f64,
     push_out: bool,
 }
 
@@ -191,6 +196,7 @@ impl Work {
                 normal: contact.normal,
                 separation: contact.separation,
                 impulse: contact.impulse,
+                step_impulse: 0.0,
                 push_out: contact.push_out,
             });
         }
