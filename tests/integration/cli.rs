@@ -2,13 +2,7 @@
 
 use std::process::{Command, Output};
 
-fn ballpit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ballpit"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("the ballpit binary runs")
-}
+use crate::common::ballpit;
 
 /// Runs ballpit and asserts it succeeded, showing its error output if not.
 fn ballpit_ok(args: &[&str]) -> Output {

@@ -1,4 +1,5 @@
-//! Shared builders: headless apps with given balls, and readers of their state.
+//! Shared builders: headless apps with given balls, and readers of their state; the
+//! `ballpit` binary run with arguments.
 
 use ballpit::prelude::*;
 use bevy::math::DVec2;
@@ -119,4 +120,13 @@ pub fn record_collisions(app: &mut App) {
     }
     app.init_resource::<Recorded>()
         .add_systems(FixedUpdate, record.after(SimulationStep));
+}
+
+/// Runs the `ballpit` binary with `args` from the package's folder.
+pub fn ballpit(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_ballpit"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("the ballpit binary runs")
 }

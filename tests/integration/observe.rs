@@ -4,15 +4,8 @@
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn ballpit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ballpit"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("the ballpit binary runs")
-}
+use crate::common::ballpit;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("ballpit-{name}-{}", std::process::id()));
