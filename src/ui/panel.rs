@@ -364,9 +364,13 @@ fn readouts(ui: &mut egui::Ui, shown: &Shown) {
                     ui.end_row();
                 }
             });
+            // A fresh scene has one point or none: at least a second of axis, from its start.
+            let start = r.energy_history.front().map_or(0.0, |point| point[0]);
             let points: PlotPoints = r.energy_history.iter().copied().collect();
             Plot::new("energy-plot")
                 .height(90.0)
+                .include_x(start)
+                .include_x(start + 1.0)
                 .include_y(0.0)
                 .allow_drag(false)
                 .allow_zoom(false)
