@@ -68,7 +68,6 @@ pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: Sof
     let decay = (-step.damping * h).exp();
     let mut work = Work::new(bodies, contacts);
     for (contact, link) in contacts.iter_mut().zip(&work.links) {
-        contact.step_impulse = 0.0;
         contact.bounced = false;
         contact.closing_velocity = work.speed_at_contact(link, step.gravity);
     }
