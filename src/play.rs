@@ -33,7 +33,7 @@ pub struct PlayOptions {
 
 /// Opens the window and runs until it is closed (or the screenshot is saved).
 pub fn play(options: PlayOptions) -> AppExit {
-    let window = fit_window(options.arena, PANEL_WIDTH).0;
+    let window = fit_window(options.arena, PANEL_WIDTH);
     let mut app = App::new();
     app.add_plugins(DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {

@@ -16,7 +16,9 @@ pub fn plugin(app: &mut App) {
             ..default()
         })
         .init_resource::<view::AimGuide>()
+        .init_resource::<view::NewBallGuide>()
         .init_resource::<view::PanelVisible>()
+        .init_resource::<view::HelpVisible>()
         .init_resource::<view::UiRng>()
         .add_plugins(scenes::plugin);
 }

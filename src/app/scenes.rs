@@ -1,16 +1,14 @@
 //! The scene being played and the player's requests to reset, reseed or switch it. Requests
 //! arrive as [`SceneRequest`] messages (from the panel and the keys) and are applied as world
-//! commands in `Update`; the window is resized and zoomed to fit the new arena. A scene that
+//! commands in `Update`; the view is zoomed to fit the new arena, the window keeping its size. A scene that
 //! fails to load leaves the current one playing and its error in [`SceneStatus`].
 
 use std::path::PathBuf;
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy::window::PrimaryWindow;
 use rand::RngExt;
 
-use super::view::{PlayArea, UiRng, fit_window};
+use super::view::{PlayArea, UiRng};
 use crate::sim::SceneFile;
 
 pub(super) fn plugin(app: &mut App) {
@@ -80,9 +78,8 @@ fn apply_scene_request(world: &mut World, request: SceneRequest) {
     }
     match scene.file.build(&scene.origin) {
         Ok(setup) => {
-            let arena = setup.params.arena_size;
             setup.apply(world);
-            resize_window_for(world, arena);
+            fit_view(world);
             world.insert_resource(scene);
             world.resource_mut::<SceneStatus>().0 = None;
             world.write_message(SceneLoaded);
@@ -91,17 +88,7 @@ fn apply_scene_request(world: &mut World, request: SceneRequest) {
     }
 }
 
-/// Zooms and asks for a window that show `arena` beside the panel. Until the window arrives
-/// the arena keeps the scene's size; then it follows the window.
-fn resize_window_for(world: &mut World, arena: DVec2) {
-    let mut play_area = *world.resource::<PlayArea>();
-    let (wanted, zoom) = fit_window(arena.as_vec2(), play_area.panel_width);
-    play_area.zoom = zoom;
-    world.insert_resource(play_area);
-    let mut windows = world.query_filtered::<&mut Window, With<PrimaryWindow>>();
-    if let Ok(mut window) = windows.single_mut(world)
-        && window.size() != wanted
-    {
-        window.resolution.set(wanted.x, wanted.y);
-    }
+/// Fits the view to the new arena; the window keeps its size.
+fn fit_view(world: &mut World) {
+    world.resource_mut::<PlayArea>().request_fit();
 }

@@ -1,7 +1,7 @@
-//! Drawing the simulation: a 2D camera, one sprite per ball, overlays and effects. Reads
-//! simulation state and the view state ([`app::view`](crate::app::view)); writes only the
-//! arena size (the arena is the window's play area). Runs in the windowed app's
-//! `Update`/`PostUpdate`, never in the headless one.
+//! Drawing the simulation: a 2D camera placed as the view says, the arena's floor and border,
+//! one sprite per ball, overlays and effects. Reads simulation state and the view state
+//! ([`app::view`](crate::app::view)); writes only the view's fit to the window. Runs in the
+//! windowed app's `Update`/`PostUpdate`, never in the headless one.
 //!
 //! Every ball's sprite shares one anti-aliased circle texture made at start-up, so all balls
 //! draw as one batch and stay round at any size. Sprites are placed between the last two
@@ -18,7 +18,9 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy::window::PrimaryWindow;
 
-use crate::app::view::{ColourMode, PlayArea, ViewSettings};
+use crate::app::view::{
+    ColourMode, HOT_SPEED, PlayArea, SIZE_COLOUR_RANGE, ViewSettings, heat_colour,
+};
 use crate::sim::{
     Ball, BallId, Position, PreviousPosition, Radius, Rest, RunControl, SimParams, Velocity,
 };
@@ -30,12 +32,10 @@ const CIRCLE_TEXTURE_SIZE: u32 = 256;
 const BACKGROUND: Color = Color::srgb(0.03, 0.035, 0.045);
 /// The arena's floor, drawn behind the balls.
 const ARENA_FLOOR: Color = Color::srgb(0.07, 0.08, 0.1);
-/// Speed shown as the hottest colour in [`ColourMode::BySpeed`], pixels per second.
-const HOT_SPEED: f64 = 600.0;
+/// The arena's walls, drawn as a line around the floor.
+const ARENA_BORDER: Color = Color::srgb(0.35, 0.4, 0.5);
 /// How much darker a sleeping ball is drawn (with the view's toggle on), 0 to 1.
 const SLEEP_DIMMING: f32 = 0.25;
-/// Radius range spanned by the colours of [`ColourMode::BySize`], pixels.
-const SIZE_COLOUR_RANGE: (f64, f64) = (5.0, 50.0);
 
 pub fn plugin(app: &mut App) {
     app.insert_resource(ClearColor(BACKGROUND))
@@ -43,7 +43,7 @@ pub fn plugin(app: &mut App) {
         .add_systems(PreStartup, make_circle_texture)
         .add_systems(Startup, (spawn_camera, spawn_arena_floor))
         .add_observer(give_ball_a_sprite)
-        .add_systems(Update, fit_arena_to_window)
+        .add_systems(Update, keep_view_fitted)
         .add_systems(
             PostUpdate,
             (place_ball_sprites, colour_balls, place_camera_and_floor)
@@ -102,12 +102,6 @@ fn make_circle_texture(mut commands: Commands, mut images: ResMut<Assets<Image>>
 pub fn ball_colour(id: BallId) -> Color {
     let hue = (id.0 as f32 * 137.507_77) % 360.0;
     Color::hsl(hue, 0.65, 0.6)
-}
-
-/// A colour from cool (0) to hot (1).
-pub fn heat_colour(heat: f64) -> Color {
-    let heat = heat.clamp(0.0, 1.0) as f32;
-    Color::hsl(240.0 * (1.0 - heat), 0.75, 0.55)
 }
 
 fn colour_of(mode: ColourMode, id: BallId, radius: f64, velocity: DVec2) -> Color {
@@ -177,51 +171,37 @@ fn colour_balls(
         });
 }
 
-/// The arena is the window's play area (right of the panel): its walls follow a resize, and
-/// balls left outside after a shrink are brought back in by the walls. A window with no play
-/// area (minimised, or narrower than the panel) leaves the arena as it was, so nothing is
-/// squeezed and the balls are where they were when it comes back.
-fn fit_arena_to_window(
+/// Keeps the view fitted to the arena while it follows the fit (see [`PlayArea`]): a new
+/// scene, `F`, a resized window or arena.
+fn keep_view_fitted(
     window: Single<&Window, With<PrimaryWindow>>,
-    play_area: Res<PlayArea>,
-    mut params: ResMut<SimParams>,
+    params: Res<SimParams>,
+    mut play_area: ResMut<PlayArea>,
 ) {
-    let Some(size) = play_area.arena_for_window(window.size()) else {
-        return;
-    };
-    let size = size.as_dvec2();
-    if params.arena_size != size {
-        params.arena_size = size;
+    let mut fitted = *play_area;
+    fitted.keep_fitted(params.arena_size.as_vec2(), window.size());
+    if fitted != *play_area {
+        *play_area = fitted;
     }
 }
 
-/// Zooms the camera by the play area's zoom and shifts it so the arena (centred on the origin)
-/// sits right of the panel.
+/// Places and zooms the camera as the play area says, and sizes the arena's floor and border.
 fn place_camera_and_floor(
     play_area: Res<PlayArea>,
     params: Res<SimParams>,
     mut camera: Single<(&mut Transform, &mut Projection), (With<Camera2d>, Without<ArenaFloor>)>,
     mut floor: Single<(&mut Transform, &mut Sprite), With<ArenaFloor>>,
+    mut gizmos: Gizmos,
 ) {
     let (transform, projection) = &mut *camera;
-    transform.translation.x = -play_area.panel_width / 2.0 * play_area.zoom;
+    transform.translation = play_area.center.extend(transform.translation.z);
     if let Projection::Orthographic(orthographic) = &mut **projection
         && orthographic.scale != play_area.zoom
     {
         orthographic.scale = play_area.zoom;
     }
+    let arena = params.arena_size.as_vec2();
     floor.0.translation = Vec3::new(0.0, 0.0, -1.0);
-    floor.1.custom_size = Some(params.arena_size.as_vec2());
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn heat_runs_from_blue_to_red_and_clamps() {
-        assert_eq!(heat_colour(-1.0), heat_colour(0.0));
-        assert_eq!(heat_colour(7.0), heat_colour(1.0));
-        assert_ne!(heat_colour(0.0), heat_colour(1.0));
-    }
+    floor.1.custom_size = Some(arena);
+    gizmos.rect_2d(Isometry2d::IDENTITY, arena, ARENA_BORDER);
 }

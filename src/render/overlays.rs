@@ -1,15 +1,16 @@
-//! Overlays drawn with gizmos on top of the balls: AABBs, contact points, velocity arrows and
-//! the snooker-style aiming guide. Each is switched in [`ViewSettings`]; the guide shows while
-//! a ball is being dragged. Runs in the windowed app's `Update`.
+//! Overlays drawn with gizmos on top of the balls: AABBs, contact points, velocity arrows
+//! (each switched in [`ViewSettings`]); and while the player drags, the snooker-style aiming
+//! guide, the new ball's ghost and throw, and a carried ball's spring. Runs in the windowed app's `Update`.
 
 use bevy::prelude::*;
 
 use super::interpolate::{drawn_position, interpolation_fraction};
-use crate::app::view::{AimGuide, ViewSettings};
+use crate::app::view::{AimGuide, NewBallGuide, ViewSettings};
 use crate::sim::aim::{AimTarget, predict_first_hit, time_to_wall};
 use crate::sim::geometry::Circle;
 use crate::sim::{
-    Ball, ContactPoints, Position, PreviousPosition, Radius, RunControl, SimParams, Velocity,
+    Ball, Carried, ContactPoints, Position, PreviousPosition, Radius, RunControl, SimParams,
+    Velocity,
 };
 
 /// Seconds of motion a velocity arrow shows.
@@ -23,12 +24,19 @@ const AABB_COLOUR: Color = Color::srgba(0.5, 0.8, 1.0, 0.5);
 const CONTACT_COLOUR: Color = Color::srgb(1.0, 0.9, 0.2);
 const ARROW_COLOUR: Color = Color::srgba(1.0, 1.0, 1.0, 0.7);
 const GUIDE_COLOUR: Color = Color::srgb(0.95, 0.95, 0.95);
-const EXIT_COLOUR: Color = Color::srgb(1.0, 0.55, 0.2);
+const CARRY_COLOUR: Color = Color::srgba(1.0, 1.0, 1.0, 0.6);
 
 pub(super) fn plugin(app: &mut App) {
     app.add_systems(
         Update,
-        (draw_aabbs, draw_contacts, draw_velocities, draw_aim_guide),
+        (
+            draw_aabbs,
+            draw_contacts,
+            draw_velocities,
+            draw_aim_guide,
+            draw_new_ball_guide,
+            draw_carry_springs,
+        ),
     );
 }
 
@@ -84,23 +92,24 @@ fn draw_velocities(
     }
 }
 
-/// The guide: the path to the first ball the aimed ball would hit (or to the wall), the
-/// aimed ball's outline at the hit, the collision point, and the directions both leave in.
+/// The guide: the path to the first ball the aimed ball would hit (or to the wall), both
+/// balls' ghosts at the hit (the struck one where its own motion takes it), the collision
+/// point, and the directions both leave in, each arrow in its ball's colour.
 fn draw_aim_guide(
     guide: Res<AimGuide>,
     params: Res<SimParams>,
-    balls: Query<(Entity, &Position, &Velocity, &Radius), With<Ball>>,
+    balls: Query<(Entity, &Position, &Velocity, &Radius, &Sprite), With<Ball>>,
     mut gizmos: Gizmos,
 ) {
     let Some(aim) = guide.0 else { return };
-    let Ok((_, position, _, radius)) = balls.get(aim.ball) else {
+    let Ok((_, position, _, radius, sprite)) = balls.get(aim.ball) else {
         return;
     };
     let cue = Circle::new(position.0, radius.0);
     let horizon = time_to_wall(cue.center, aim.velocity, cue.radius, params.half_extents())
         .min(GUIDE_HORIZON);
     let targets = balls.iter().filter(|(entity, ..)| *entity != aim.ball).map(
-        |(entity, position, velocity, radius)| AimTarget {
+        |(entity, position, velocity, radius, _)| AimTarget {
             id: entity,
             circle: Circle::new(position.0, radius.0),
             velocity: velocity.0,
@@ -119,15 +128,25 @@ fn draw_aim_guide(
     ) {
         Some(hit) => {
             let at_hit = hit.cue_center.as_vec2();
+            let struck = balls.get(hit.target).ok();
+            let struck_colour = struck.map_or(GUIDE_COLOUR, |ball| ball.4.color);
+            let struck_radius = struck.map_or(0.0, |ball| ball.3.0 as f32);
+            let struck_at_hit = hit.target_center.as_vec2();
             gizmos.line_2d(start, at_hit, GUIDE_COLOUR);
             gizmos.circle_2d(at_hit, cue.radius as f32, GUIDE_COLOUR);
+            if let Some((_, now, ..)) = struck
+                && now.0.as_vec2().distance(struck_at_hit) > 0.5
+            {
+                gizmos.line_2d(now.0.as_vec2(), struck_at_hit, dimmed(struck_colour));
+            }
+            gizmos.circle_2d(struck_at_hit, struck_radius, struck_colour);
             gizmos.circle_2d(hit.point.as_vec2(), 3.0, CONTACT_COLOUR);
-            for (from, velocity) in [
-                (at_hit, hit.cue_velocity_after),
-                (hit.target_center.as_vec2(), hit.target_velocity_after),
+            for (from, velocity, colour) in [
+                (at_hit, hit.cue_velocity_after, sprite.color),
+                (struck_at_hit, hit.target_velocity_after, struck_colour),
             ] {
                 if let Some(direction) = velocity.as_vec2().try_normalize() {
-                    gizmos.arrow_2d(from, from + direction * EXIT_ARROW_LENGTH, EXIT_COLOUR);
+                    gizmos.arrow_2d(from, from + direction * EXIT_ARROW_LENGTH, colour);
                 }
             }
         }
@@ -138,4 +157,36 @@ fn draw_aim_guide(
         }
         None => {}
     }
+}
+
+/// The ball a drag from empty space will add (a ghost) and its throw (an arrow).
+fn draw_new_ball_guide(guide: Res<NewBallGuide>, mut gizmos: Gizmos) {
+    let Some(ball) = guide.0 else { return };
+    let centre = ball.position.as_vec2();
+    gizmos.circle_2d(centre, ball.radius as f32, GUIDE_COLOUR);
+    let throw = ball.velocity.as_vec2() * ARROW_SECONDS;
+    if throw.length() > 1.0 {
+        gizmos.arrow_2d(centre, centre + throw, GUIDE_COLOUR);
+    }
+}
+
+/// Each carried ball's spring: a line from the ball to the pointer it follows.
+fn draw_carry_springs(
+    fixed: Res<Time<Fixed>>,
+    run: Res<RunControl>,
+    balls: Query<(&PreviousPosition, &Position, &Carried)>,
+    mut gizmos: Gizmos,
+) {
+    let fraction = interpolation_fraction(&fixed, &run);
+    for (previous, position, carried) in &balls {
+        let centre = drawn_position(previous, position, fraction);
+        let target = carried.target.as_vec2();
+        gizmos.line_2d(centre, target, CARRY_COLOUR);
+        gizmos.circle_2d(target, 3.0, CARRY_COLOUR);
+    }
+}
+
+/// `colour` at half its opacity.
+fn dimmed(colour: Color) -> Color {
+    colour.with_alpha(colour.alpha() * 0.5)
 }

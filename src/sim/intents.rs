@@ -1,18 +1,21 @@
-//! What a player (or any driver of the simulation) asks of it: fling a ball, add one, set the
-//! ball count. The UI sends [`Intent`] messages; [`apply_intents`] applies them in the fixed
-//! step, before the stages, paused or not, so the stages never see a ball change mid-step and
-//! the UI never writes simulation components itself. A flung ball that rests or sleeps flies,
-//! and its sleeping island wakes; a new ball wakes the islands it touches (the resting stage
-//! sees to that); changing the count wakes every island, since balls may have gone from
-//! under others.
+//! What a player (or any driver of the simulation) asks of it: fling, carry, release or
+//! remove a ball, add one, set the ball count. The UI sends [`Intent`] messages;
+//! [`apply_intents`] applies them in the fixed step, before the stages, paused or not, so the
+//! stages never see a ball change mid-step and the UI never writes simulation components
+//! itself. A flung or carried ball that rests or sleeps flies, and its sleeping island wakes;
+//! a new ball wakes the islands it touches (the resting stage sees to that); removing balls
+//! wakes every island, since balls may have gone from under others. Carrying is
+//! [`carry`](super::carry)'s.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{BallState, Rest, RestState, Velocity};
-use super::params::{MAX_SPEED, RADIUS_RANGE};
+use super::ball::{Ball, BallState, Position, PreviousPosition, Radius, Rest, Velocity};
+use super::carry::{Carried, paused_carry_stop, set_free};
+use super::geometry::Circle;
+use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, RADIUS_SLIDER, RunControl, SimParams};
 use super::resting::RestingState;
-use super::spawn::{set_ball_count, spawn_ball};
+use super::spawn::{add_smaller_balls, radius_to_fit, set_ball_count, spawn_ball};
 
 /// A request to change the simulation's balls.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -23,14 +26,49 @@ pub enum Intent {
     Spawn(BallState),
     /// Add balls at random free spots, or remove the newest, until there are this many.
     SetBallCount(usize),
+    /// As `SetBallCount`, the added balls made as small as they must be to fit
+    /// ([`add_smaller_balls`]): what the panel offers when the arena is full.
+    AddSmallerBalls(usize),
+    /// Hold `ball` and carry it towards `target` (arena pixels); sent again as the pointer
+    /// moves. Paused, it moves there at once, stopping at the first ball or wall on the way.
+    Carry { ball: Entity, target: DVec2 },
+    /// Let a carried ball go at this velocity (pixels per second; clamped as a fling is).
+    Release { ball: Entity, velocity: DVec2 },
+    /// Take this ball out of the simulation.
+    Remove(Entity),
 }
 
-/// The last [`Intent::SetBallCount`]: how many balls were asked for and how many there are.
-/// Fewer are reached when the arena is full.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// The last [`Intent::SetBallCount`] or [`Intent::AddSmallerBalls`]: how many balls were
+/// asked for and how many there are (fewer when the arena is full), and the radius that
+/// [`Intent::AddSmallerBalls`] would give the rest (`None`: not even the smallest fit).
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct BallCountOutcome {
     pub wanted: usize,
     pub reached: usize,
+    pub smaller_radius: Option<f64>,
+}
+
+impl BallCountOutcome {
+    /// What the panel says under the count slider when the count asked for was not reached:
+    /// the arena is full, and what to do about it.
+    pub fn note(&self) -> Option<String> {
+        (self.reached < self.wanted).then(|| {
+            let advice = match self.smaller_radius {
+                Some(radius) => format!(
+                    "“Add smaller balls” adds the rest at radius {radius:.1} px; or enlarge the \
+                     arena."
+                ),
+                None => format!(
+                    "Even balls of {:.0} px radius do not fit: enlarge the arena.",
+                    RADIUS_SLIDER.start()
+                ),
+            };
+            format!(
+                "The arena is full: {} of {} balls fit. {advice}",
+                self.reached, self.wanted
+            )
+        })
+    }
 }
 
 /// Applies every intent sent since the last fixed step, in the order sent.
@@ -42,15 +80,7 @@ pub fn apply_intents(mut intents: MessageReader<Intent>, mut commands: Commands)
 
 fn apply(world: &mut World, intent: Intent) {
     match intent {
-        Intent::Fling { ball, velocity } => {
-            let velocity = velocity.clamp_length_max(MAX_SPEED);
-            if let Some(mut current) = world.get_mut::<Velocity>(ball)
-                && velocity.is_finite()
-            {
-                current.0 = velocity;
-                wake_and_free(world, ball);
-            }
-        }
+        Intent::Fling { ball, velocity } => fling(world, ball, velocity),
         Intent::Spawn(state) => {
             // Only a ball the simulation accepts: finite, with a radius in range.
             let valid = state.position.is_finite()
@@ -60,24 +90,94 @@ fn apply(world: &mut World, intent: Intent) {
                 spawn_ball(world, state);
             }
         }
-        Intent::SetBallCount(wanted) => {
-            let reached = set_ball_count(world, wanted);
-            world.resource_mut::<RestingState>().wake_all = true;
-            world.insert_resource(BallCountOutcome { wanted, reached });
+        Intent::SetBallCount(wanted) => set_count(world, wanted, set_ball_count),
+        Intent::AddSmallerBalls(wanted) => set_count(world, wanted, add_smaller_balls),
+        Intent::Carry { ball, target } => carry(world, ball, target),
+        Intent::Release { ball, velocity } => {
+            if let Ok(mut entity) = world.get_entity_mut(ball) {
+                entity.remove::<Carried>();
+                fling(world, ball, velocity);
+            }
+        }
+        Intent::Remove(ball) => {
+            if world.get::<Ball>(ball).is_some() {
+                world.despawn(ball);
+                world.resource_mut::<RestingState>().wake_all = true;
+            }
         }
     }
 }
 
-/// Sets `ball` flying; if it slept, its island wakes at the next step.
-fn wake_and_free(world: &mut World, ball: Entity) {
-    let Some(mut rest) = world.get_mut::<Rest>(ball) else {
+/// Sets the ball count with `set` and records the outcome; every island wakes, since balls
+/// may have gone from under others.
+fn set_count(world: &mut World, wanted: usize, set: fn(&mut World, usize) -> usize) {
+    let reached = set(world, wanted);
+    world.resource_mut::<RestingState>().wake_all = true;
+    let smaller_radius = (reached < wanted).then(|| {
+        let mut radii = world.query_filtered::<&Radius, With<Ball>>();
+        let covered: f64 = radii
+            .iter(world)
+            .map(|radius| std::f64::consts::PI * radius.0 * radius.0)
+            .sum();
+        let arena = world.resource::<SimParams>().arena_size;
+        radius_to_fit(arena, covered, wanted.min(MAX_BALLS) - reached)
+    });
+    world.insert_resource(BallCountOutcome {
+        wanted,
+        reached,
+        smaller_radius: smaller_radius.flatten(),
+    });
+}
+
+/// Gives `ball` `velocity` (clamped to the accepted speed) and sets it flying.
+fn fling(world: &mut World, ball: Entity, velocity: DVec2) {
+    let velocity = velocity.clamp_length_max(MAX_SPEED);
+    if let Some(mut current) = world.get_mut::<Velocity>(ball)
+        && velocity.is_finite()
+    {
+        current.0 = velocity;
+        wake_and_free(world, ball);
+    }
+}
+
+/// Holds `ball` with its target at `target`; paused, moves it there at once as far as the
+/// way is free, and holds it still.
+fn carry(world: &mut World, ball: Entity, target: DVec2) {
+    let Some(&Position(center)) = world.get::<Position>(ball) else {
         return;
     };
-    let state = std::mem::take(&mut *rest).state;
-    if let RestState::Asleep { island } = state {
-        world
-            .resource_mut::<RestingState>()
-            .wake_requests
-            .push(island);
+    let Some(&Radius(radius)) = world.get::<Radius>(ball) else {
+        return;
+    };
+    if !target.is_finite() {
+        return;
     }
+    world.entity_mut(ball).insert(Carried { target });
+    wake_and_free(world, ball);
+    if !world.resource::<RunControl>().paused {
+        return;
+    }
+    let half = world.resource::<SimParams>().half_extents();
+    let others: Vec<Circle> = world
+        .query_filtered::<(Entity, &Position, &Radius), With<Ball>>()
+        .iter(world)
+        .filter(|(other, ..)| *other != ball)
+        .map(|(_, position, radius)| Circle::new(position.0, radius.0))
+        .collect();
+    let stop = paused_carry_stop(Circle::new(center, radius), target, others, half);
+    let mut entity = world.entity_mut(ball);
+    entity.insert((
+        Position(stop),
+        PreviousPosition(stop),
+        Velocity(DVec2::ZERO),
+    ));
+}
+
+/// Sets `ball` flying; if it slept, its island wakes at the next step.
+fn wake_and_free(world: &mut World, ball: Entity) {
+    world.resource_scope(|world, mut resting: Mut<RestingState>| {
+        if let Some(mut rest) = world.get_mut::<Rest>(ball) {
+            set_free(&mut rest, &mut resting);
+        }
+    });
 }

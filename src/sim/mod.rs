@@ -15,7 +15,7 @@
 //! | [`SimSystems::Response`] | [`resolve_contacts`](discrete::resolve::resolve_contacts): exchange, separation, walls | [`run_timeline`](continuous::run_timeline): the impacts in time order |
 //! | [`SimSystems::Resting`] | [`rest_and_sleep`](resting::rest_and_sleep): the resting solver, who rests next step, sleep | the same |
 //! | [`SimSystems::Report`] | [`report_step`](report::report_step): messages, counters, contact points | the same |
-//! | around the stages | the clock's `start_step` before, `take_pending_step` and `end_step` in `Report`; a finiteness assertion in debug builds | the same |
+//! | around the stages | the clock's `start_step` and [`steer_carried`](carry::steer_carried) (the player's hand) before, `take_pending_step` and `end_step` in `Report`; a finiteness assertion in debug builds | the same |
 //!
 //! **Data flows one way**: components → [`BallSnapshot`](ball::BallSnapshot) (movement) →
 //! contacts or predicted impacts (collision) → components (response), each stage recording
@@ -35,6 +35,7 @@
 
 pub mod aim;
 pub mod ball;
+pub mod carry;
 pub mod clock;
 pub mod continuous;
 pub mod discrete;
@@ -60,6 +61,7 @@ use bevy::prelude::*;
 pub use ball::{
     Ball, BallId, BallState, Position, PreviousPosition, Radius, Rest, RestState, Velocity,
 };
+pub use carry::Carried;
 pub use clock::SimClock;
 pub use intents::{BallCountOutcome, Intent};
 pub use measure::{SimStats, StateSummary};
@@ -118,7 +120,9 @@ impl Plugin for SimPlugin {
             .add_systems(
                 SimSchedule,
                 (
-                    clock::start_step.before(Movement),
+                    (clock::start_step, carry::steer_carried)
+                        .chain()
+                        .before(Movement),
                     // The pipeline: each stage, the system of each mode.
                     stage(Movement, Discrete, movement::move_and_contain),
                     stage(Movement, Continuous, movement::damp_velocities),

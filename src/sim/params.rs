@@ -39,8 +39,11 @@ pub const MAX_BALLS: usize = 1_000_000;
 
 /// The ball-count slider's range.
 pub const BALL_COUNT_SLIDER: RangeInclusive<usize> = 0..=100_000;
-/// The radius sliders' range, pixels.
-pub const RADIUS_SLIDER: RangeInclusive<f64> = 0.5..=200.0;
+/// The radius sliders' range, pixels: the smallest is the smallest ball a player adds (a
+/// click or the count slider), 6 px across, large enough to see and to click.
+pub const RADIUS_SLIDER: RangeInclusive<f64> = 3.0..=200.0;
+/// The arena sliders' range (each side), pixels.
+pub const ARENA_SLIDER: RangeInclusive<f64> = 50.0..=100_000.0;
 /// The speed sliders' range, pixels per second.
 pub const SPEED_SLIDER: RangeInclusive<f64> = 0.0..=3_000.0;
 /// The gravity sliders' range (each component), pixels per second squared.

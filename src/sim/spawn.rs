@@ -10,7 +10,7 @@ use bevy::prelude::*;
 
 use super::ball::{Ball, BallId, BallState, NextBallId, Position, Radius, ball_bundle};
 use super::geometry::Circle;
-use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, SimParams};
+use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, RADIUS_SLIDER, SimParams};
 use super::scene::placement::PlacementGrid;
 use super::scene::{SimRng, draw_ball};
 
@@ -112,9 +112,41 @@ pub fn set_ball_count(world: &mut World, target: usize) -> usize {
     count
 }
 
+/// The share of an arena's free area that balls added at random free spots may fill: random
+/// sequential addition of equal discs jams near 0.55, and finds spots quickly well below it.
+pub const FILL_SHARE: f64 = 0.3;
+
+/// The radius of `more` equal balls that fill [`FILL_SHARE`] of the area an arena of `arena`
+/// pixels has free beside balls covering `covered` square pixels; `None` when that is
+/// smaller than the smallest ball a player adds, or no area is free.
+pub fn radius_to_fit(arena: DVec2, covered: f64, more: usize) -> Option<f64> {
+    let free = arena.x * arena.y - covered;
+    let radius = (FILL_SHARE * free / (std::f64::consts::PI * more.max(1) as f64)).sqrt();
+    let largest = *RADIUS_SLIDER.end();
+    (radius >= *RADIUS_SLIDER.start()).then_some(radius.min(largest))
+}
+
+/// Adds balls until there are `target` as [`set_ball_count`] does, drawing the added balls'
+/// radius as [`radius_to_fit`] gives (and keeping it in the [`SpawnSettings`]), so that they
+/// fit beside the balls already there. Returns the count reached.
+pub fn add_smaller_balls(world: &mut World, target: usize) -> usize {
+    let circles: Vec<f64> = world
+        .query_filtered::<&Radius, With<Ball>>()
+        .iter(world)
+        .map(|radius| radius.0)
+        .collect();
+    let covered: f64 = circles.iter().map(|r| std::f64::consts::PI * r * r).sum();
+    let more = target.min(MAX_BALLS).saturating_sub(circles.len());
+    let arena = world.resource::<SimParams>().arena_size;
+    if let Some(radius) = radius_to_fit(arena, covered, more) {
+        world.resource_mut::<SpawnSettings>().radius = (radius, radius);
+    }
+    set_ball_count(world, target)
+}
+
 /// The radius of a ball centred at `point` that fits in the arena `[-half, half]` without
 /// overlapping any of `nearby`: `wanted` when there is room, smaller when not, `None` when
-/// not even the smallest ball fits.
+/// not even the smallest ball a player adds (the radius sliders' least) fits.
 pub fn fit_radius_at(
     point: DVec2,
     wanted: f64,
@@ -127,12 +159,26 @@ pub fn fit_radius_at(
         .map(|circle| circle.center.distance(point) - circle.radius)
         .fold(to_walls, f64::min);
     let radius = wanted.min(room);
-    (radius >= *RADIUS_RANGE.start()).then_some(radius)
+    (radius >= *RADIUS_SLIDER.start()).then_some(radius)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_radius_to_fit_fills_a_share_of_the_free_area() {
+        let arena = DVec2::new(800.0, 600.0);
+        let covered = 80_000.0;
+        let radius = radius_to_fit(arena, covered, 2_000).unwrap();
+        let filled = 2_000.0 * std::f64::consts::PI * radius * radius;
+        assert!((filled / (480_000.0 - covered) - FILL_SHARE).abs() < 1e-12);
+        // Too many for the smallest ball, or no room: none.
+        assert_eq!(radius_to_fit(arena, covered, 100_000), None);
+        assert_eq!(radius_to_fit(arena, 480_000.0, 1), None);
+        // A few balls in a large arena: no larger than the sliders reach.
+        assert_eq!(radius_to_fit(arena, 0.0, 1), Some(*RADIUS_SLIDER.end()));
+    }
 
     #[test]
     fn fit_radius_shrinks_to_the_room_available() {
@@ -144,6 +190,8 @@ mod tests {
             fit_radius_at(DVec2::new(95.0, 0.0), 25.0, half, []),
             Some(5.0)
         );
+        // Room for less than the smallest ball a player adds: none.
+        assert_eq!(fit_radius_at(DVec2::new(98.0, 0.0), 25.0, half, []), None);
         assert_eq!(
             fit_radius_at(DVec2::new(25.0, 0.0), 25.0, half, others),
             None

@@ -1,10 +1,15 @@
-//! The player's controls: the egui side panel ([`panel`]) and the mouse and keys ([`input`]).
+//! The player's controls: the egui side panel ([`panel`]), the pointer on the balls
+//! ([`hands`]) and the wheel and keys ([`input`]), sharing [`pointer`]'s helpers.
 //! They read simulation state and change it only through intents (flings, spawns, the ball
 //! count), the parameter resources (edited as clamped copies), single steps and scene
 //! requests. Runs in the windowed app only.
 
+pub mod figures;
+pub mod hands;
+pub mod help;
 pub mod input;
 pub mod panel;
+pub mod pointer;
 pub mod readouts;
 
 use bevy::prelude::*;

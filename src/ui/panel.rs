@@ -13,21 +13,30 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, RichText, Slider, SliderClamping, emath::Numeric};
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass};
-use egui_plot::{Bar, BarChart, Line, Plot, PlotPoints};
 
+use super::figures::{gas, readouts};
+use super::help::help_window;
 use super::readouts::Readouts;
 use crate::app::scenes::{CurrentScene, SceneRequest, SceneStatus};
-use crate::app::view::{ColourMode, PANEL_WIDTH, PanelVisible, PlayArea, ViewSettings};
-use crate::diagnostics::frame_figures;
+use crate::app::view::{
+    ColourMode, HOT_SPEED, HelpVisible, PANEL_WIDTH, PanelVisible, PlayArea, SIZE_COLOUR_RANGE,
+    ViewSettings, heat_colour,
+};
+use crate::diagnostics::{frame_figures, game_speed};
 use crate::sim::params::{
-    BALL_COUNT_SLIDER, DAMPING_SLIDER, DEFAULT_STEP_RATE, GRAVITY_SLIDER, RADIUS_SLIDER,
-    RESTITUTION_RANGE, SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
+    ARENA_SLIDER, BALL_COUNT_SLIDER, DAMPING_SLIDER, DEFAULT_STEP_RATE, GRAVITY_SLIDER,
+    RADIUS_SLIDER, RESTITUTION_RANGE, SPEED_SLIDER, STEP_RATE_SLIDER, TIME_SCALE_SLIDER,
 };
 use crate::sim::resting::RestingState;
 use crate::sim::{
     BallCountOutcome, CollisionMode, Intent, MassModel, RunControl, SimParams, Solver,
     SpawnSettings,
 };
+
+/// Below this game speed against real time the panel warns that the game runs slow.
+const SLOW_GAME: f64 = 0.95;
+/// The colour of warnings: a full arena, a slow game.
+const WARNING: Color32 = Color32::from_rgb(255, 190, 90);
 
 /// Where the scene picker looks for scene files, relative to the working directory.
 pub const SCENE_FOLDER: &str = "assets/scenes";
@@ -56,17 +65,6 @@ impl SceneList {
     }
 }
 
-/// What the panel says under the count slider when the last count asked for was not
-/// reached: the arena is full.
-pub fn ball_count_note(outcome: &BallCountOutcome) -> Option<String> {
-    (outcome.reached < outcome.wanted).then(|| {
-        format!(
-            "The arena is full: {} of {} balls fit. Shrink the radii or enlarge the window.",
-            outcome.reached, outcome.wanted
-        )
-    })
-}
-
 /// Everything the panel edits.
 #[derive(SystemParam)]
 struct Tunables<'w> {
@@ -93,6 +91,7 @@ struct Shown<'w> {
 fn draw_panel(
     mut contexts: EguiContexts,
     mut visible: ResMut<PanelVisible>,
+    mut help: ResMut<HelpVisible>,
     mut play_area: ResMut<PlayArea>,
     mut tunables: Tunables,
     shown: Shown,
@@ -112,6 +111,7 @@ fn draw_panel(
                     visible.0 = true;
                 }
             });
+        help_window(ctx, &mut help.0);
         return Ok(());
     }
     let mut root = egui::Ui::new(
@@ -128,20 +128,48 @@ fn draw_panel(
             egui::ScrollArea::vertical().show(ui, |ui| {
                 ui.horizontal(|ui| {
                     ui.heading("ballpit");
+                    if ui.small_button("Help (?)").clicked() {
+                        help.0 = !help.0;
+                    }
                     if ui.small_button("Hide (H)").clicked() {
                         visible.0 = false;
                     }
                 });
-                ui.label(RichText::new("Space pause · N step · R reset · H hide").small());
+                status(ui, &shown);
                 controls(ui, &mut tunables, &shown, &mut requests);
-                balls(ui, &mut tunables.spawn, &shown, &mut intents);
+                balls(ui, &mut tunables, &shown, &mut intents);
                 physics(ui, &mut tunables);
-                readouts(ui, &shown);
+                view(ui, &mut tunables.view, &mut play_area);
+                readouts(
+                    ui,
+                    &shown.readouts,
+                    &shown.diagnostics,
+                    shown.resting.asleep,
+                );
                 gas(ui, &shown.readouts);
-                view(ui, &mut tunables.view);
             });
         });
+    help_window(ctx, &mut help.0);
     Ok(())
+}
+
+/// The figures a player glances at, on one line: FPS, simulation time per frame, balls,
+/// sleeping balls; and a warning when the game runs slower than real time.
+fn status(ui: &mut egui::Ui, shown: &Shown) {
+    let (_, fps, simulation_ms) = frame_figures(&shown.diagnostics);
+    ui.label(format!(
+        "{:.0} FPS · simulation {:.1} ms/frame · {} balls · {} asleep",
+        fps.unwrap_or(0.0),
+        simulation_ms.unwrap_or(0.0),
+        shown.readouts.summary.ball_count,
+        shown.resting.asleep
+    ));
+    if let Some(speed) = game_speed(&shown.diagnostics).filter(|&speed| speed < SLOW_GAME) {
+        ui.colored_label(
+            WARNING,
+            format!("Slower than real time: {speed:.2}× (fewer balls or steps /s catch up)"),
+        );
+    }
 }
 
 fn controls(
@@ -211,7 +239,7 @@ fn step_rate(slider_value: f64) -> f64 {
 
 fn balls(
     ui: &mut egui::Ui,
-    spawn: &mut SpawnSettings,
+    tunables: &mut Tunables,
     shown: &Shown,
     intents: &mut MessageWriter<Intent>,
 ) {
@@ -227,25 +255,49 @@ fn balls(
             if response.changed() {
                 intents.write(Intent::SetBallCount(count));
             }
-            if let Some(note) = ball_count_note(&shown.ball_count) {
-                ui.colored_label(Color32::from_rgb(255, 190, 90), note);
+            if let Some(note) = shown.ball_count.note() {
+                ui.colored_label(WARNING, note);
+                let wanted = shown.ball_count.wanted;
+                if shown.ball_count.smaller_radius.is_some()
+                    && ui.button("Add smaller balls").clicked()
+                {
+                    intents.write(Intent::AddSmallerBalls(wanted));
+                }
             }
-            let mut edited = *spawn;
+            let spawn = &mut tunables.spawn;
+            let mut edited = **spawn;
             ui.add(
                 slider(&mut edited.radius.0, RADIUS_SLIDER)
                     .logarithmic(true)
-                    .text("radius min"),
+                    .text("radius min px"),
             );
             ui.add(
                 slider(&mut edited.radius.1, RADIUS_SLIDER)
                     .logarithmic(true)
-                    .text("radius max"),
+                    .text("radius max px"),
             );
-            ui.add(slider(&mut edited.speed.0, SPEED_SLIDER).text("speed min"));
-            ui.add(slider(&mut edited.speed.1, SPEED_SLIDER).text("speed max"));
+            ui.add(slider(&mut edited.speed.0, SPEED_SLIDER).text("speed min px/s"));
+            ui.add(slider(&mut edited.speed.1, SPEED_SLIDER).text("speed max px/s"));
             edited.clamp_to_limits();
-            if edited != *spawn {
-                *spawn = edited;
+            if edited != **spawn {
+                **spawn = edited;
+            }
+            let mut arena = tunables.params.arena_size;
+            ui.add(
+                slider(&mut arena.x, ARENA_SLIDER)
+                    .logarithmic(true)
+                    .text("arena width px"),
+            );
+            ui.add(
+                slider(&mut arena.y, ARENA_SLIDER)
+                    .logarithmic(true)
+                    .text("arena height px"),
+            );
+            if arena != tunables.params.arena_size {
+                let mut params = tunables.params.clone();
+                params.arena_size = arena;
+                params.clamp_to_limits();
+                *tunables.params = params;
             }
         });
 }
@@ -308,9 +360,9 @@ fn physics(ui: &mut egui::Ui, tunables: &mut Tunables) {
         });
 }
 
-fn view(ui: &mut egui::Ui, view: &mut ViewSettings) {
+fn view(ui: &mut egui::Ui, view: &mut ViewSettings, play_area: &mut PlayArea) {
     egui::CollapsingHeader::new("View")
-        .default_open(false)
+        .default_open(true)
         .show(ui, |ui| {
             let mut edited = view.clone();
             ui.horizontal(|ui| {
@@ -319,121 +371,59 @@ fn view(ui: &mut egui::Ui, view: &mut ViewSettings) {
                 ui.radio_value(&mut edited.colour_mode, ColourMode::BySize, "size");
                 ui.radio_value(&mut edited.colour_mode, ColourMode::BySpeed, "speed");
             });
-            ui.checkbox(&mut edited.show_aabbs, "AABBs");
-            ui.checkbox(&mut edited.show_contacts, "contact points");
-            ui.checkbox(&mut edited.show_velocities, "velocity arrows");
-            ui.checkbox(&mut edited.show_bursts, "collision bursts");
-            ui.checkbox(&mut edited.dim_sleeping, "dim sleeping balls");
+            colour_legend(ui, edited.colour_mode);
+            ui.horizontal_wrapped(|ui| {
+                ui.checkbox(&mut edited.show_aabbs, "AABBs");
+                ui.checkbox(&mut edited.show_contacts, "contacts");
+                ui.checkbox(&mut edited.show_velocities, "velocities");
+                ui.checkbox(&mut edited.show_bursts, "bursts");
+                ui.checkbox(&mut edited.dim_sleeping, "dim sleeping");
+            });
             if edited != *view {
                 *view = edited;
             }
+            ui.horizontal(|ui| {
+                ui.label(format!("zoom {:.2} px/px", play_area.zoom));
+                if ui.button("Fit (F)").clicked() {
+                    play_area.request_fit();
+                }
+            });
         });
 }
 
-fn readouts(ui: &mut egui::Ui, shown: &Shown) {
-    egui::CollapsingHeader::new("Readouts")
-        .default_open(true)
-        .show(ui, |ui| {
-            let (frame_ms, fps, simulation_ms) = frame_figures(&shown.diagnostics);
-            let r = &shown.readouts;
-            egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
-                for (name, value) in [
-                    ("FPS", format!("{:.0}", fps.unwrap_or(0.0))),
-                    ("frame ms", format!("{:.1}", frame_ms.unwrap_or(0.0))),
-                    (
-                        "simulation ms",
-                        format!("{:.1}", simulation_ms.unwrap_or(0.0)),
-                    ),
-                    ("balls", format!("{}", r.summary.ball_count)),
-                    ("sleeping", format!("{}", shown.resting.asleep)),
-                    ("collisions /s", format!("{:.0}", r.collisions_per_second)),
-                    (
-                        "kinetic energy",
-                        format!("{:.4e}", r.summary.kinetic_energy),
-                    ),
-                    (
-                        "momentum",
-                        format!(
-                            "({:.3e}, {:.3e})",
-                            r.summary.momentum.x, r.summary.momentum.y
-                        ),
-                    ),
-                ] {
-                    ui.label(name);
-                    ui.monospace(value);
-                    ui.end_row();
-                }
-            });
-            // A fresh scene has one point or none: at least a second of axis, from its start.
-            let start = r.energy_history.front().map_or(0.0, |point| point[0]);
-            let points: PlotPoints = r.energy_history.iter().copied().collect();
-            Plot::new("energy-plot")
-                .height(90.0)
-                .include_x(start)
-                .include_x(start + 1.0)
-                .include_y(0.0)
-                .allow_drag(false)
-                .allow_zoom(false)
-                .allow_scroll(false)
-                .allow_boxed_zoom(false)
-                .x_axis_label("simulated s")
-                .show(ui, |plot| plot.line(Line::new("kinetic energy", points)));
-        });
-}
-
-/// Temperature, pressure and the speed histogram against the Maxwell–Boltzmann curve.
-fn gas(ui: &mut egui::Ui, readouts: &Readouts) {
-    egui::CollapsingHeader::new("Gas")
-        .default_open(true)
-        .show(ui, |ui| {
-            egui::Grid::new("gas").num_columns(2).show(ui, |ui| {
-                for (name, value) in [
-                    (
-                        "temperature",
-                        format!("{:.4e}", readouts.summary.temperature()),
-                    ),
-                    ("pressure", format!("{:.4e}", readouts.pressure)),
-                ] {
-                    ui.label(name);
-                    ui.monospace(value);
-                    ui.end_row();
-                }
-            });
-            let histogram = &readouts.summary.speed_histogram;
-            let width = histogram.bin_width;
-            let bars = histogram
-                .counts
-                .iter()
-                .enumerate()
-                .map(|(bin, &count)| {
-                    Bar::new((bin as f64 + 0.5) * width, count as f64).width(width)
-                })
-                .collect();
-            let curve: PlotPoints = histogram
-                .expected
-                .iter()
-                .enumerate()
-                .map(|(bin, &expected)| [(bin as f64 + 0.5) * width, expected])
-                .collect();
-            Plot::new("speed-histogram")
-                .height(120.0)
-                .include_y(0.0)
-                .allow_drag(false)
-                .allow_zoom(false)
-                .allow_scroll(false)
-                .allow_boxed_zoom(false)
-                .x_axis_label("speed px/s")
-                .show(ui, |plot| {
-                    plot.bar_chart(
-                        BarChart::new("balls", bars).color(Color32::from_rgb(90, 140, 220)),
-                    );
-                    plot.line(
-                        Line::new("Maxwell–Boltzmann", curve)
-                            .color(Color32::from_rgb(240, 170, 60))
-                            .width(2.0),
-                    );
-                });
-        });
+/// What the colours mean: a scale from cool to hot with its ends, or a word for one colour
+/// per ball.
+fn colour_legend(ui: &mut egui::Ui, mode: ColourMode) {
+    let (low, high) = match mode {
+        ColourMode::ByBall => {
+            ui.label(RichText::new("each ball its own colour").small());
+            return;
+        }
+        ColourMode::BySize => (
+            format!("r ≤ {:.0} px", SIZE_COLOUR_RANGE.0),
+            format!("≥ {:.0} px", SIZE_COLOUR_RANGE.1),
+        ),
+        ColourMode::BySpeed => ("still".to_string(), format!("≥ {HOT_SPEED:.0} px/s")),
+    };
+    ui.horizontal(|ui| {
+        ui.label(RichText::new(low).small());
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(120.0, 12.0), egui::Sense::hover());
+        const STEPS: usize = 24;
+        for step in 0..STEPS {
+            let [r, g, b, _] = heat_colour(step as f64 / (STEPS - 1) as f64)
+                .to_srgba()
+                .to_u8_array();
+            let width = rect.width() / STEPS as f32;
+            let left = rect.left() + width * step as f32;
+            let cell = egui::Rect::from_min_size(
+                egui::pos2(left, rect.top()),
+                egui::vec2(width + 0.5, rect.height()),
+            );
+            ui.painter()
+                .rect_filled(cell, 0.0, Color32::from_rgb(r, g, b));
+        }
+        ui.label(RichText::new(high).small());
+    });
 }
 
 #[cfg(test)]

@@ -2,11 +2,10 @@
 //! (a missing resource, a bad schedule) fails here rather than on a player's screen.
 
 use ballpit::app::scenes::{CurrentScene, SceneRequest, SceneStatus};
-use ballpit::app::view::{PANEL_WIDTH, PanelVisible, PlayArea};
+use ballpit::app::view::{FIT_MARGIN, PANEL_WIDTH, PanelVisible, PlayArea};
 use ballpit::play::GamePlugin;
 use ballpit::prelude::*;
 use ballpit::sim::BallCountOutcome;
-use ballpit::ui::panel::ball_count_note;
 use bevy::input::ButtonState;
 use bevy::input::keyboard::{Key, KeyboardInput, NativeKey};
 use bevy::prelude::*;
@@ -113,23 +112,47 @@ fn a_bad_scene_request_keeps_the_current_scene_and_reports() {
 }
 
 #[test]
-fn the_arena_follows_the_window_and_a_shrink_brings_balls_back_in() {
+fn the_window_is_a_view_of_the_arena_fitted_until_zoomed_and_still_when_the_panel_hides() {
     let mut app = windowless_game("gas.ron");
     let window = add_window(&mut app);
-    // Loading the scene sizes the window to fit it; then the player resizes it.
     app.update();
-    resize_window(&mut app, window, (1400.0, 900.0), 3);
-    // The gas (1,083 px square) is taller than the largest window: shown zoomed out.
-    let panel = PANEL_WIDTH as f64;
-    let zoom = app.world().resource::<PlayArea>().zoom as f64;
-    assert!(zoom > 1.0 && zoom < 1.1, "zoom {zoom}");
     let arena = app.world().resource::<SimParams>().arena_size;
-    let expected = bevy::math::DVec2::new(1400.0 - panel, 900.0) * zoom;
-    assert!((arena - expected).length() < 1e-3, "{arena} vs {expected}");
-    resize_window(&mut app, window, (700.0, 500.0), 3);
-    let half = app.world().resource::<SimParams>().half_extents();
-    let expected = bevy::math::DVec2::new(700.0 - panel, 500.0) * zoom / 2.0;
-    assert!((half - expected).length() < 1e-3, "{half} vs {expected}");
+    resize_window(&mut app, window, (1400.0, 900.0), 3);
+    // The arena keeps the scene's size; the view fits it right of the panel.
+    assert_eq!(app.world().resource::<SimParams>().arena_size, arena);
+    let area = *app.world().resource::<PlayArea>();
+    let room = 900.0 - 2.0 * FIT_MARGIN;
+    assert!((area.zoom - arena.y as f32 / room).abs() < 1e-4, "{area:?}");
+    assert_eq!(area.center, Vec2::new(-PANEL_WIDTH / 2.0 * area.zoom, 0.0));
+    // Hiding the panel moves nothing on screen.
+    press(&mut app, KeyCode::KeyH);
+    assert!(!app.world().resource::<PanelVisible>().0);
+    let hidden = *app.world().resource::<PlayArea>();
+    assert_eq!((hidden.zoom, hidden.center), (area.zoom, area.center));
+    // Zoomed by the player, a resize keeps the zoom; F fits again.
+    app.world_mut()
+        .resource_mut::<PlayArea>()
+        .zoom_at(Vec2::ZERO, 0.5);
+    resize_window(&mut app, window, (1000.0, 700.0), 2);
+    assert!((app.world().resource::<PlayArea>().zoom - area.zoom * 0.5).abs() < 1e-6);
+    press(&mut app, KeyCode::KeyF);
+    let fitted = *app.world().resource::<PlayArea>();
+    assert!((fitted.zoom - arena.y as f32 / (700.0 - 2.0 * FIT_MARGIN)).abs() < 1e-4);
+    // Loading a scene keeps the window's size and fits the new arena.
+    app.world_mut()
+        .write_message(SceneRequest::Load("assets/scenes/billiards.ron".into()));
+    app.update();
+    app.update();
+    let size = app.world().get::<Window>(window).unwrap().size();
+    assert_eq!(size, Vec2::new(1000.0, 700.0));
+    let arena = app.world().resource::<SimParams>().arena_size.as_vec2();
+    let zoom = app.world().resource::<PlayArea>().zoom;
+    let shown = (size - Vec2::new(0.0, 0.0) - Vec2::splat(2.0 * FIT_MARGIN)) * zoom;
+    assert!(
+        shown.x >= arena.x - 1e-3 && shown.y >= arena.y - 1e-3,
+        "{shown} {arena}"
+    );
+    assert!((shown.x - arena.x).abs() < 1e-3 || (shown.y - arena.y).abs() < 1e-3);
     assert_all_inside(&mut app);
 }
 
@@ -161,7 +184,7 @@ fn asking_for_more_balls_than_fit_gives_a_note_not_a_hang() {
     app.update();
     let world = app.world_mut();
     let balls = world.query_filtered::<(), With<Ball>>().iter(world).count();
-    let note = ball_count_note(world.resource::<BallCountOutcome>());
+    let note = world.resource::<BallCountOutcome>().note();
     assert!(balls > 40 && balls < 1_000, "{balls}");
     let note = note.expect("a note when the arena is full");
     assert!(
@@ -171,10 +194,7 @@ fn asking_for_more_balls_than_fit_gives_a_note_not_a_hang() {
     // A request that is met clears it.
     app.world_mut().write_message(Intent::SetBallCount(10));
     app.update();
-    assert_eq!(
-        ball_count_note(app.world().resource::<BallCountOutcome>()),
-        None
-    );
+    assert_eq!(app.world().resource::<BallCountOutcome>().note(), None);
 }
 
 /// Presses `key` for one frame and releases it, as the window's keyboard messages would:

@@ -7,6 +7,7 @@ mod common;
 mod continuous;
 #[cfg(feature = "gui")]
 mod game;
+mod hands;
 mod house;
 mod observe;
 mod physics;

@@ -65,7 +65,8 @@ fn intents_apply_at_the_next_fixed_step_even_while_paused() {
             *app.world().resource::<BallCountOutcome>(),
             BallCountOutcome {
                 wanted: 30,
-                reached: 30
+                reached: 30,
+                smaller_radius: None,
             }
         );
     }

@@ -5,8 +5,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::sim::params::{
-    ARENA_SIDE_RANGE, DAMPING_SLIDER, GRAVITY_SLIDER, RADIUS_SLIDER, RESTITUTION_RANGE,
-    SPEED_SLIDER, STEP_RATE_SLIDER,
+    ARENA_SIDE_RANGE, DAMPING_SLIDER, GRAVITY_SLIDER, RESTITUTION_RANGE, SPEED_SLIDER,
+    STEP_RATE_SLIDER,
 };
 use crate::sim::{CollisionMode, MassModel, SceneFile, SceneSetup};
 
@@ -45,12 +45,16 @@ pub(super) fn extreme(
     }
 }
 
+/// The radii scenes are drawn from, pixels: from the smallest a scene file may hold to the
+/// largest the radius sliders reach.
+const SOAK_RADII: std::ops::RangeInclusive<f64> = 0.5..=200.0;
+
 impl SoakScene {
     /// Draws scene number `seed`, with at most `max_balls` balls.
     pub fn draw(seed: u64, max_balls: usize) -> SoakScene {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let r_min = extreme(&mut rng, &RADIUS_SLIDER, true);
-        let r_max = extreme(&mut rng, &(r_min..=*RADIUS_SLIDER.end()), true);
+        let r_min = extreme(&mut rng, &SOAK_RADII, true);
+        let r_max = extreme(&mut rng, &(r_min..=*SOAK_RADII.end()), true);
         let s_min = extreme(&mut rng, &SPEED_SLIDER, false);
         let s_max = extreme(&mut rng, &(s_min..=*SPEED_SLIDER.end()), false);
         let count = extreme(&mut rng, &(2.0..=max_balls.max(2) as f64), true).round() as usize;
@@ -148,8 +152,8 @@ mod tests {
         let restitutions: Vec<f64> = scenes.iter().map(|s| s.scene.restitution).collect();
         assert!(restitutions.contains(&0.0) && restitutions.contains(&1.0));
         let radii = scenes.iter().map(|s| s.scene.generate.unwrap().radius);
-        assert!(radii.clone().any(|r| r.0 == *RADIUS_SLIDER.start()));
-        assert!(radii.clone().any(|r| r.1 == *RADIUS_SLIDER.end()));
+        assert!(radii.clone().any(|r| r.0 == *SOAK_RADII.start()));
+        assert!(radii.clone().any(|r| r.1 == *SOAK_RADII.end()));
         assert!(
             scenes
                 .iter()

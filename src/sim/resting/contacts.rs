@@ -69,11 +69,19 @@ pub struct NearPairs {
 
 impl NearPairs {
     /// Finds the pairs and walls near touching among `circles` moving at `velocities` in the
-    /// arena `[-half, half]`: within the margin, or within reach of a step of `dt`.
-    pub fn find(&mut self, circles: &[Circle], velocities: &[DVec2], half: DVec2, dt: f64) {
+    /// arena `[-half, half]`: within the margin, or within reach of a step of `dt` (for the
+    /// walls, a step falling under `gravity` too; the balls all fall alike).
+    pub fn find(
+        &mut self,
+        circles: &[Circle],
+        velocities: &[DVec2],
+        (half, gravity): (DVec2, DVec2),
+        dt: f64,
+    ) {
         let reach = |circle: &Circle, velocity: &DVec2| {
             circle.radius * CONTACT_MARGIN + velocity.length() * dt
         };
+        let fall = gravity.length() * dt * dt;
         self.inflated.clear();
         self.inflated.extend(
             circles
@@ -120,7 +128,7 @@ impl NearPairs {
                 let outward = wall.outward_normal();
                 let axis = usize::from(outward.y != 0.0);
                 let gap = half[axis] - circle.radius - circle.center.dot(outward);
-                if gap <= reach(circle, velocity) {
+                if gap <= reach(circle, velocity) + fall {
                     self.walls.push((index as u32, wall, gap));
                     self.touching[index] |= within_margin(gap, circle.radius);
                     self.near[index] = true;

@@ -125,7 +125,7 @@ pub fn rest_and_sleep(
     state.near.find(
         &snapshot.circles,
         &snapshot.velocities,
-        params.half_extents(),
+        (params.half_extents(), params.gravity),
         dt,
     );
     sleep::wake_touched(state);
@@ -215,15 +215,44 @@ fn solve(
         .collect();
     state.warm = warm;
     let half = params.half_extents();
+    let mut stop_impulse = 0.0;
     for (index, body) in bodies.iter().enumerate() {
         if body.inverse_mass > 0.0 {
             let circle = &mut snapshot.circles[index];
-            circle.center = inside_arena(body.position + body.shift, circle.radius, half);
+            let (center, velocity) = stop_at_walls(
+                body.position + body.shift,
+                body.velocity,
+                circle.radius,
+                half,
+            );
+            circle.center = center;
+            stop_impulse += (body.velocity - velocity).length() / body.inverse_mass;
             // A safety net: no velocity leaves the solver faster than any ball may go.
-            snapshot.velocities[index] = body.velocity.clamp_length_max(MAX_SPEED);
+            snapshot.velocities[index] = velocity.clamp_length_max(MAX_SPEED);
         }
     }
-    state.near.total_wall_impulse()
+    state.near.total_wall_impulse() + stop_impulse
+}
+
+/// A solved ball's `center` put back inside the arena `[-half, half]` and its `velocity`
+/// into each wall it was put back from stopped, as the wall would have stopped it: the
+/// solver sees only the walls found near at the start of the step.
+fn stop_at_walls(center: DVec2, velocity: DVec2, radius: f64, half: DVec2) -> (DVec2, DVec2) {
+    let inside = inside_arena(center, radius, half);
+    let pushed = inside - center;
+    let stopped = DVec2::new(
+        if pushed.x * velocity.x < 0.0 {
+            0.0
+        } else {
+            velocity.x
+        },
+        if pushed.y * velocity.y < 0.0 {
+            0.0
+        } else {
+            velocity.y
+        },
+    );
+    (inside, stopped)
 }
 
 /// The contacts that bounced in the solver are hits like any other, at the end of the step.
