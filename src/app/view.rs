@@ -15,8 +15,8 @@ use crate::sim::BallState;
 pub const PANEL_WIDTH: f32 = 290.0;
 /// Largest window the toy opens or resizes to, logical pixels.
 const MAX_WINDOW: Vec2 = Vec2::new(1600.0, 1000.0);
-/// Smallest window the toy resizes to for a scene, logical pixels.
-const MIN_WINDOW: Vec2 = Vec2::new(640.0, 400.0);
+/// Smallest window the toy opens, logical pixels: the whole panel fits in it.
+const MIN_WINDOW: Vec2 = Vec2::new(1280.0, 720.0);
 
 /// How balls are coloured.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -217,8 +217,8 @@ mod tests {
     #[test]
     fn the_window_opens_one_to_one_for_small_arenas_and_at_most_the_largest() {
         let margins = Vec2::splat(2.0 * FIT_MARGIN);
-        let window = fit_window(Vec2::new(800.0, 600.0), 300.0);
-        assert_eq!(window, Vec2::new(1100.0, 600.0) + margins);
+        let window = fit_window(Vec2::new(1200.0, 800.0), 300.0);
+        assert_eq!(window, Vec2::new(1500.0, 800.0) + margins);
         assert_eq!(fit_window(Vec2::new(3000.0, 3000.0), 300.0).y, MAX_WINDOW.y);
         assert_eq!(fit_window(Vec2::new(10.0, 10.0), 300.0), MIN_WINDOW);
     }

@@ -46,8 +46,10 @@ pub fn carry_velocity(from: DVec2, target: DVec2, dt: f64) -> DVec2 {
     ((target - from) * rate).clamp_length_max(MAX_CARRY_SPEED)
 }
 
-/// Each step, every carried ball gets its spring's velocity and flies (a resting or
-/// sleeping one leaves the resting solver; its island wakes).
+/// Each step, every carried ball gets its spring's velocity; a sleeping one wakes with its
+/// island. A carried ball that rests stays in the resting solver, which moves it at that
+/// velocity and pushes the resting balls around it out of its way (a flying one would only
+/// be stopped against them).
 pub fn steer_carried(
     clock: Res<SimClock>,
     solver: Res<Solver>,
@@ -60,7 +62,14 @@ pub fn steer_carried(
             let reach = DISCRETE_CARRY_REACH * radius.0 / clock.dt;
             velocity.0 = velocity.0.clamp_length_max(reach);
         }
-        set_free(&mut rest, &mut resting);
+        wake_if_asleep(&mut rest, &mut resting);
+    }
+}
+
+/// Wakes a sleeping ball and its island (a resting or flying one stays as it is).
+pub fn wake_if_asleep(rest: &mut Rest, resting: &mut RestingState) {
+    if rest.is_asleep() {
+        set_free(rest, resting);
     }
 }
 

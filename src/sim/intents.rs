@@ -11,7 +11,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::ball::{Ball, BallState, Position, PreviousPosition, Radius, Rest, Velocity};
-use super::carry::{Carried, paused_carry_stop, set_free};
+use super::carry::{Carried, paused_carry_stop, set_free, wake_if_asleep};
 use super::geometry::Circle;
 use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, RADIUS_SLIDER, RunControl, SimParams};
 use super::resting::RestingState;
@@ -153,7 +153,11 @@ fn carry(world: &mut World, ball: Entity, target: DVec2) {
         return;
     }
     world.entity_mut(ball).insert(Carried { target });
-    wake_and_free(world, ball);
+    world.resource_scope(|world, mut resting: Mut<RestingState>| {
+        if let Some(mut rest) = world.get_mut::<Rest>(ball) {
+            wake_if_asleep(&mut rest, &mut resting);
+        }
+    });
     if !world.resource::<RunControl>().paused {
         return;
     }

@@ -26,8 +26,9 @@ use crate::sim::{Ball, BallState, Intent, Position, Radius, SimParams, SpawnSett
 
 /// How far (window pixels) a right press may move and still be a click, not a drag.
 const CLICK_SLOP: f32 = 4.0;
-/// Seconds of pointer motion a carried ball's throw is measured over.
-const THROW_WINDOW: f64 = 0.08;
+/// Seconds of pointer motion a carried ball's throw is measured over (at least the last two
+/// frames).
+const THROW_WINDOW: f64 = 0.1;
 
 /// What the pointer is doing, between frames.
 #[derive(Resource, Debug, Default, Clone, PartialEq)]
@@ -175,10 +176,7 @@ pub(super) fn drag_and_release(
                 true // the ball is gone (reset, count lowered)
             } else if buttons.pressed(*button) {
                 if let Some(pointer) = pointer {
-                    trail.push_back((now, pointer.arena));
-                    while trail.front().is_some_and(|&(t, _)| now - t > THROW_WINDOW) {
-                        trail.pop_front();
-                    }
+                    follow(trail, now, pointer.arena);
                     intents.write(Intent::Carry {
                         ball: *ball,
                         target: pointer.arena,
@@ -186,6 +184,9 @@ pub(super) fn drag_and_release(
                 }
                 false
             } else {
+                if let Some(pointer) = pointer {
+                    follow(trail, now, pointer.arena);
+                }
                 intents.write(Intent::Release {
                     ball: *ball,
                     velocity: throw_velocity(trail),
@@ -253,6 +254,15 @@ fn guide(
     }
 }
 
+/// Adds the pointer at `at` (real seconds `now`) to a carry's `trail`, keeping the last
+/// [`THROW_WINDOW`] of it, and at least two samples however slow the frames.
+fn follow(trail: &mut VecDeque<(f64, DVec2)>, now: f64, at: DVec2) {
+    trail.push_back((now, at));
+    while trail.len() > 2 && trail[1].0 <= now - THROW_WINDOW {
+        trail.pop_front();
+    }
+}
+
 /// The pointer's velocity over its recent `trail`, pixels per second: zero when it was still
 /// or the trail is too short to tell; at most [`MAX_FLING_SPEED`].
 pub fn throw_velocity(trail: &VecDeque<(f64, DVec2)>) -> DVec2 {
@@ -274,6 +284,27 @@ fn pointer_at(window: &Window, camera: (&Camera, &GlobalTransform)) -> Option<Po
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_trail_keeps_its_window_and_at_least_two_samples() {
+        let mut trail = VecDeque::new();
+        for (t, x) in [
+            (0.0, 0.0),
+            (0.05, 5.0),
+            (0.3, 30.0),
+            (0.32, 34.0),
+            (0.35, 40.0),
+        ] {
+            follow(&mut trail, t, DVec2::new(x, 0.0));
+        }
+        // The last tenth of a second and the sample just before it.
+        let kept: Vec<f64> = trail.iter().map(|s| s.0).collect();
+        assert_eq!(kept, vec![0.05, 0.3, 0.32, 0.35]);
+        let mut slow = VecDeque::new();
+        follow(&mut slow, 0.0, DVec2::ZERO);
+        follow(&mut slow, 0.5, DVec2::new(50.0, 0.0));
+        assert_eq!(throw_velocity(&slow), DVec2::new(100.0, 0.0));
+    }
 
     #[test]
     fn a_throw_is_the_pointers_recent_velocity() {

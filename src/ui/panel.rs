@@ -383,7 +383,7 @@ fn view(ui: &mut egui::Ui, view: &mut ViewSettings, play_area: &mut PlayArea) {
                 *view = edited;
             }
             ui.horizontal(|ui| {
-                ui.label(format!("zoom {:.2} px/px", play_area.zoom));
+                ui.label(format!("zoom {:.0} %", 100.0 / play_area.zoom));
                 if ui.button("Fit (F)").clicked() {
                     play_area.request_fit();
                 }

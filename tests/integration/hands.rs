@@ -4,7 +4,7 @@
 
 use ballpit::prelude::*;
 use ballpit::sim::carry::MAX_CARRY_SPEED;
-use ballpit::sim::{BallCountOutcome, Carried};
+use ballpit::sim::{BallCountOutcome, Carried, Rest};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
@@ -164,4 +164,41 @@ fn from_the_demo_the_count_slider_and_the_notes_one_control_reach_5000_balls() {
     step(&mut app, 1);
     let note = app.world().resource::<BallCountOutcome>().note().unwrap();
     assert!(note.contains("enlarge the arena"), "{note}");
+}
+
+#[test]
+fn a_carried_ball_wakes_a_sleeping_pile_and_pushes_its_way_up_through_it() {
+    for mode in CollisionMode::ALL {
+        let params = SimParams {
+            gravity: DVec2::new(0.0, -500.0),
+            restitution: 0.5,
+            arena_size: DVec2::new(400.0, 400.0),
+            ..default()
+        };
+        // A column of three standing on the floor, asleep after a second.
+        let column = [-190.0, -170.0, -150.0].map(|y| ball(0.0, y, 0.0, 0.0, 10.0));
+        let mut app = app_in(mode, params, &column);
+        step(&mut app, 60);
+        let asleep = |app: &mut App| {
+            let world = app.world_mut();
+            let mut rests = world.query::<&Rest>();
+            rests.iter(world).filter(|rest| rest.is_asleep()).count()
+        };
+        assert_eq!(asleep(&mut app), 3, "{mode:?}");
+        let bottom = entity_of(&mut app, 0);
+        for _ in 0..90 {
+            carry(&mut app, bottom, DVec2::new(0.0, 100.0));
+            step(&mut app, 1);
+        }
+        let balls = states(&mut app);
+        assert!(balls[0].position.y > 50.0, "{mode:?}: {:?}", balls[0]);
+        for (i, a) in balls.iter().enumerate() {
+            for b in &balls[i + 1..] {
+                let gap = a.position.distance(b.position) - a.radius - b.radius;
+                assert!(gap > -2.0, "{mode:?}: overlap {gap}");
+            }
+        }
+        // The balls above were pushed up or aside, never passed through.
+        assert!(balls[1].position.y > balls[0].position.y || balls[1].position.x.abs() > 5.0);
+    }
 }
