@@ -91,6 +91,11 @@ fn the_game_builds_loads_its_scene_and_steps_without_a_window() {
     let step = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     assert!((step - 1.0 / 60.0).abs() < 1e-9, "{step}");
     assert!(world.resource::<SimClock>().steps >= 2);
+    // A slow frame advances the game by at most the catch-up bound: at 60 steps a second,
+    // four steps, so it never makes the next frame slower.
+    let bound = world.resource::<Time<Virtual>>().max_delta();
+    assert_eq!(bound, ballpit::diagnostics::MAX_CATCH_UP);
+    assert!((bound.as_secs_f64() / step - 4.0).abs() < 1e-3);
 }
 
 #[test]
