@@ -1,8 +1,8 @@
-//! Mouse and keys. The pointer on the balls is [`hands`](super::hands)'s; here are the wheel
-//! and the keys. The wheel zooms at the pointer; `F` fits the arena; `Delete` (or
-//! `Backspace`) removes the ball under the pointer; `?` (or F1) shows every input; Space pauses (on release, unless the view
-//! was dragged with it held); N steps once; R resets; H hides the panel. Pointer and keys over
-//! the panel stay with the panel. Runs in the windowed app's `Update`.
+//! Mouse and keys. The pointer on the balls is [`hands`]'s; here are the wheel and the keys.
+//! The wheel zooms at the pointer; `F` fits the arena; `Delete` (or `Backspace`) removes the
+//! ball under the pointer; `?` (or F1) shows every input; Space pauses (on release, unless the
+//! view was dragged with it held); N steps once; R resets; H hides the panel. Pointer and keys
+//! over the panel stay with the panel. Runs in the windowed app's `Update`.
 
 use bevy::input::mouse::{MouseScrollUnit, MouseWheel};
 use bevy::prelude::*;
