@@ -1,8 +1,8 @@
 //! The player's controls: the egui side panel ([`panel`]), the pointer on the balls
 //! ([`hands`]) and the wheel and keys ([`input`]), sharing [`pointer`](mod@pointer)'s helpers.
 //! They read simulation state and change it only through intents (flings, carries, spawns,
-//! removals, the ball count), the parameter resources (edited as clamped copies), single steps and scene
-//! requests. Runs in the windowed app only.
+//! removals, the ball count), the parameter resources (edited as clamped copies), single
+//! steps and scene requests. Runs in the windowed app only.
 
 pub mod figures;
 pub mod hands;
