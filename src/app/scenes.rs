@@ -1,7 +1,8 @@
 //! The scene being played and the player's requests to reset, reseed or switch it. Requests
 //! arrive as [`SceneRequest`] messages (from the panel and the keys) and are applied as world
-//! commands in `Update`; the view is zoomed to fit the new arena, the window keeping its size. A scene that
-//! fails to load leaves the current one playing and its error in [`SceneStatus`].
+//! commands in `Update`; the view is zoomed to fit the new arena, the window keeping its
+//! size. A scene that fails to load leaves the current one playing and its error in
+//! [`SceneStatus`].
 
 use std::path::PathBuf;
 
@@ -79,16 +80,12 @@ fn apply_scene_request(world: &mut World, request: SceneRequest) {
     match scene.file.build(&scene.origin) {
         Ok(setup) => {
             setup.apply(world);
-            fit_view(world);
+            // The window keeps its size; the view fits the new arena.
+            world.resource_mut::<PlayArea>().request_fit();
             world.insert_resource(scene);
             world.resource_mut::<SceneStatus>().0 = None;
             world.write_message(SceneLoaded);
         }
         Err(error) => world.resource_mut::<SceneStatus>().0 = Some(error.to_string()),
     }
-}
-
-/// Fits the view to the new arena; the window keeps its size.
-fn fit_view(world: &mut World) {
-    world.resource_mut::<PlayArea>().request_fit();
 }

@@ -1,6 +1,7 @@
 //! Overlays drawn with gizmos on top of the balls: AABBs, contact points, velocity arrows
 //! (each switched in [`ViewSettings`]); and while the player drags, the snooker-style aiming
-//! guide, the new ball's ghost and throw, and a carried ball's spring. Runs in the windowed app's `Update`.
+//! guide, the new ball's ghost and throw, and a carried ball's spring. Runs in the windowed
+//! app's `Update`.
 
 use bevy::prelude::*;
 

@@ -3,10 +3,10 @@
 //! gives it each step the velocity that closes a fixed fraction of its gap to the pointer,
 //! never faster than [`MAX_CARRY_SPEED`] (in the discrete mode, which does not sweep paths,
 //! never further than [`DISCRETE_CARRY_REACH`] of its radius a step), so it moves through the
-//! stages like any ball: it pushes the balls it meets, bounces off walls and never tunnels. Paused, the
-//! [`Intent::Carry`](super::Intent) moves it along the straight path to the pointer and stops
-//! it at the first ball or wall on the way ([`paused_carry_stop`]), so it never passes
-//! through one either.
+//! stages like any ball: it pushes the balls it meets, bounces off walls and never tunnels.
+//! Paused, the [`Intent::Carry`](super::Intent) moves it along the straight path to the
+//! pointer and stops it at the first ball or wall on the way ([`paused_carry_stop`]), so it
+//! never passes through one either.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;

@@ -2,10 +2,10 @@
 //! remove a ball, add one, set the ball count. The UI sends [`Intent`] messages;
 //! [`apply_intents`] applies them in the fixed step, before the stages, paused or not, so the
 //! stages never see a ball change mid-step and the UI never writes simulation components
-//! itself. A flung or carried ball that rests or sleeps flies, and its sleeping island wakes;
-//! a new ball wakes the islands it touches (the resting stage sees to that); removing balls
-//! wakes every island, since balls may have gone from under others. Carrying is
-//! [`carry`](super::carry)'s.
+//! itself. A flung ball that rests or sleeps flies, and its sleeping island wakes; a carried
+//! one that sleeps wakes with its island (one that rests stays in the resting solver, see
+//! [`carry`](super::carry)); a new ball wakes the islands it touches (the resting stage sees to that); removing balls
+//! wakes every island, since balls may have gone from under others.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -15,7 +15,7 @@ use super::carry::{Carried, paused_carry_stop, set_free, wake_if_asleep};
 use super::geometry::Circle;
 use super::params::{MAX_BALLS, MAX_SPEED, RADIUS_RANGE, RADIUS_SLIDER, RunControl, SimParams};
 use super::resting::RestingState;
-use super::spawn::{add_smaller_balls, radius_to_fit, set_ball_count, spawn_ball};
+use super::spawn::{add_smaller_balls, radius_to_fit_beside, set_ball_count, spawn_ball};
 
 /// A request to change the simulation's balls.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -113,19 +113,13 @@ fn apply(world: &mut World, intent: Intent) {
 fn set_count(world: &mut World, wanted: usize, set: fn(&mut World, usize) -> usize) {
     let reached = set(world, wanted);
     world.resource_mut::<RestingState>().wake_all = true;
-    let smaller_radius = (reached < wanted).then(|| {
-        let mut radii = world.query_filtered::<&Radius, With<Ball>>();
-        let covered: f64 = radii
-            .iter(world)
-            .map(|radius| std::f64::consts::PI * radius.0 * radius.0)
-            .sum();
-        let arena = world.resource::<SimParams>().arena_size;
-        radius_to_fit(arena, covered, wanted.min(MAX_BALLS) - reached)
-    });
+    let smaller_radius = (reached < wanted)
+        .then(|| radius_to_fit_beside(world, wanted.min(MAX_BALLS) - reached))
+        .flatten();
     world.insert_resource(BallCountOutcome {
         wanted,
         reached,
-        smaller_radius: smaller_radius.flatten(),
+        smaller_radius,
     });
 }
 
@@ -136,7 +130,7 @@ fn fling(world: &mut World, ball: Entity, velocity: DVec2) {
         && velocity.is_finite()
     {
         current.0 = velocity;
-        wake_and_free(world, ball);
+        change_rest(world, ball, set_free);
     }
 }
 
@@ -153,11 +147,7 @@ fn carry(world: &mut World, ball: Entity, target: DVec2) {
         return;
     }
     world.entity_mut(ball).insert(Carried { target });
-    world.resource_scope(|world, mut resting: Mut<RestingState>| {
-        if let Some(mut rest) = world.get_mut::<Rest>(ball) {
-            wake_if_asleep(&mut rest, &mut resting);
-        }
-    });
+    change_rest(world, ball, wake_if_asleep);
     if !world.resource::<RunControl>().paused {
         return;
     }
@@ -177,11 +167,12 @@ fn carry(world: &mut World, ball: Entity, target: DVec2) {
     ));
 }
 
-/// Sets `ball` flying; if it slept, its island wakes at the next step.
-fn wake_and_free(world: &mut World, ball: Entity) {
+/// Applies `change` to `ball`'s [`Rest`] ([`set_free`], [`wake_if_asleep`]), with the
+/// resting state it may ask to wake an island in.
+fn change_rest(world: &mut World, ball: Entity, change: fn(&mut Rest, &mut RestingState)) {
     world.resource_scope(|world, mut resting: Mut<RestingState>| {
         if let Some(mut rest) = world.get_mut::<Rest>(ball) {
-            set_free(&mut rest, &mut resting);
+            change(&mut rest, &mut resting);
         }
     });
 }

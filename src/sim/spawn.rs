@@ -126,19 +126,24 @@ pub fn radius_to_fit(arena: DVec2, covered: f64, more: usize) -> Option<f64> {
     (radius >= *RADIUS_SLIDER.start()).then_some(radius.min(largest))
 }
 
-/// Adds balls until there are `target` as [`set_ball_count`] does, drawing the added balls'
-/// radius as [`radius_to_fit`] gives (and keeping it in the [`SpawnSettings`]), so that they
-/// fit beside the balls already there. Returns the count reached.
-pub fn add_smaller_balls(world: &mut World, target: usize) -> usize {
-    let circles: Vec<f64> = world
+/// The radius [`radius_to_fit`] gives `more` balls added beside the balls in `world`, in its
+/// arena.
+pub fn radius_to_fit_beside(world: &mut World, more: usize) -> Option<f64> {
+    let covered: f64 = world
         .query_filtered::<&Radius, With<Ball>>()
         .iter(world)
-        .map(|radius| radius.0)
-        .collect();
-    let covered: f64 = circles.iter().map(|r| std::f64::consts::PI * r * r).sum();
-    let more = target.min(MAX_BALLS).saturating_sub(circles.len());
-    let arena = world.resource::<SimParams>().arena_size;
-    if let Some(radius) = radius_to_fit(arena, covered, more) {
+        .map(|radius| std::f64::consts::PI * radius.0 * radius.0)
+        .sum();
+    radius_to_fit(world.resource::<SimParams>().arena_size, covered, more)
+}
+
+/// Adds balls until there are `target` as [`set_ball_count`] does, drawing the added balls'
+/// radius as [`radius_to_fit_beside`] gives (and keeping it in the [`SpawnSettings`]), so that
+/// they fit beside the balls already there. Returns the count reached.
+pub fn add_smaller_balls(world: &mut World, target: usize) -> usize {
+    let present = world.query_filtered::<(), With<Ball>>().iter(world).count();
+    let more = target.min(MAX_BALLS).saturating_sub(present);
+    if let Some(radius) = radius_to_fit_beside(world, more) {
         world.resource_mut::<SpawnSettings>().radius = (radius, radius);
     }
     set_ball_count(world, target)

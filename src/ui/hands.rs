@@ -57,7 +57,7 @@ pub enum Hand {
 pub struct PannedWithSpace(pub bool);
 
 /// The pointer, the ball under it and what the buttons and modifier keys say.
-pub(super) struct Pointer {
+struct Pointer {
     window: Vec2,
     arena: DVec2,
 }

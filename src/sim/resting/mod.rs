@@ -240,18 +240,8 @@ fn solve(
 fn stop_at_walls(center: DVec2, velocity: DVec2, radius: f64, half: DVec2) -> (DVec2, DVec2) {
     let inside = inside_arena(center, radius, half);
     let pushed = inside - center;
-    let stopped = DVec2::new(
-        if pushed.x * velocity.x < 0.0 {
-            0.0
-        } else {
-            velocity.x
-        },
-        if pushed.y * velocity.y < 0.0 {
-            0.0
-        } else {
-            velocity.y
-        },
-    );
+    let into_a_wall = (pushed * velocity).cmplt(DVec2::ZERO);
+    let stopped = DVec2::select(into_a_wall, DVec2::ZERO, velocity);
     (inside, stopped)
 }
 
@@ -345,5 +335,32 @@ fn write_back(
             velocity.set_if_neq(Velocity(snapshot.velocities[index]));
             rest.set_if_neq(rests[index]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ball_put_back_inside_stops_moving_into_that_wall_only() {
+        let half = DVec2::new(100.0, 50.0);
+        // Past the right wall and the floor, moving into both and along neither.
+        let (center, velocity) =
+            stop_at_walls(DVec2::new(95.0, -45.0), DVec2::new(30.0, -20.0), 10.0, half);
+        assert_eq!((center, velocity), (DVec2::new(90.0, -40.0), DVec2::ZERO));
+        // Past the floor only, sliding right: the slide is kept.
+        let (center, velocity) =
+            stop_at_walls(DVec2::new(0.0, -45.0), DVec2::new(30.0, -20.0), 10.0, half);
+        assert_eq!(
+            (center, velocity),
+            (DVec2::new(0.0, -40.0), DVec2::new(30.0, 0.0))
+        );
+        // Put back but already leaving the wall: untouched velocity.
+        let (_, velocity) = stop_at_walls(DVec2::new(0.0, -45.0), DVec2::new(0.0, 5.0), 10.0, half);
+        assert_eq!(velocity, DVec2::new(0.0, 5.0));
+        // Inside: nothing changes.
+        let inside = (DVec2::new(1.0, 2.0), DVec2::new(-3.0, 4.0));
+        assert_eq!(stop_at_walls(inside.0, inside.1, 10.0, half), inside);
     }
 }
