@@ -165,7 +165,7 @@ impl NearPairs {
                 }
             })
             .collect();
-        let mut contacts = Vec::new();
+        let mut contacts = Vec::with_capacity(self.pairs.len() + self.walls.len());
         for &NearPair {
             a, b, gap, normal, ..
         } in &self.pairs

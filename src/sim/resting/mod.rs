@@ -19,7 +19,9 @@
 //! 3. `solve`: the balls that rested through the mode's stages (held still there) take one
 //!    soft step of [`solver`] with their contacts (balls that are not resting are
 //!    immovable anchors for it); the walls' impulses count towards the pressure, and the
-//!    bounces it applies are hits;
+//!    bounces it applies are hits; a ball it carried past a wall is put back and stopped
+//!    there, and [`energy`]'s guard takes back any mechanical energy the step gained beyond
+//!    what its overlaps could release;
 //! 4. `classify`: who rests next step, by mode (its comment says how);
 //! 5. `fall_asleep`: islands of touching resting balls, each ball slower than
 //!    [`SLEEP_SPEED`] for [`TIME_TO_SLEEP`] and none touching a flying ball, sleep (velocity
@@ -31,6 +33,7 @@
 
 mod constraint;
 mod contacts;
+mod energy;
 mod islands;
 mod sleep;
 pub mod solver;
@@ -41,6 +44,7 @@ use bevy::prelude::*;
 
 pub use self::islands::Islands;
 pub use self::sleep::{SLEEP_SPEED, TIME_TO_SLEEP};
+use self::energy::keep_energy;
 use self::solver::{Other, RestingContact, SoftStep, soft_step};
 use self::state::MotionKey;
 pub use self::state::RestingState;
@@ -207,6 +211,7 @@ fn solve(
         restitution: params.restitution,
         rest_speed,
     };
+    let start: Vec<DVec2> = bodies.iter().map(|body| body.velocity).collect();
     soft_step(&mut bodies, &mut contacts, step);
     log_bounces(&contacts, snapshot, params, dt, log);
     let warm = state
@@ -216,19 +221,25 @@ fn solve(
     state.warm = warm;
     let half = params.half_extents();
     let mut stop_impulse = 0.0;
+    for (body, circle) in bodies.iter_mut().zip(&snapshot.circles) {
+        if body.inverse_mass == 0.0 {
+            continue;
+        }
+        let (center, velocity) = stop_at_walls(
+            body.position + body.shift,
+            body.velocity,
+            circle.radius,
+            half,
+        );
+        stop_impulse += (body.velocity - velocity).length() / body.inverse_mass;
+        (body.shift, body.velocity) = (center - body.position, velocity);
+    }
+    keep_energy(&mut bodies, &start, &contacts, params.gravity, step.hertz);
     for (index, body) in bodies.iter().enumerate() {
         if body.inverse_mass > 0.0 {
-            let circle = &mut snapshot.circles[index];
-            let (center, velocity) = stop_at_walls(
-                body.position + body.shift,
-                body.velocity,
-                circle.radius,
-                half,
-            );
-            circle.center = center;
-            stop_impulse += (body.velocity - velocity).length() / body.inverse_mass;
+            snapshot.circles[index].center = body.position + body.shift;
             // A safety net: no velocity leaves the solver faster than any ball may go.
-            snapshot.velocities[index] = velocity.clamp_length_max(MAX_SPEED);
+            snapshot.velocities[index] = body.velocity.clamp_length_max(MAX_SPEED);
         }
     }
     state.near.total_wall_impulse() + stop_impulse
