@@ -9,11 +9,11 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::constraint::{Body, Other, RestingContact};
-use crate::sim::geometry::circle::{Circle, contact_normal};
+use crate::sim::geometry::circle::{Circle, circles_touch, contact_normal};
 use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::geometry::pairs::search_in_bands;
 use crate::sim::geometry::wall::Wall;
-use crate::sim::params::{BroadPhase, MassModel};
+use crate::sim::params::MassModel;
 
 /// Balls within this fraction of their radii of touching count as touching: a resting ball
 /// sinks about `|g|·dt²` (0.14 px at 500 px/s² and 60 steps a second) in a step before its
@@ -64,7 +64,8 @@ pub struct NearPairs {
     pub wall_impulse_of: Vec<f64>,
     grid: UniformGrid,
     inflated: Vec<Circle>,
-    found: Vec<IndexedContact>,
+    /// The grid's pairs of `inflated` circles that touch: `(a, b)`, `a < b`.
+    found: Vec<(u32, u32)>,
 }
 
 impl NearPairs {
@@ -90,12 +91,14 @@ impl NearPairs {
                 .map(|(c, v)| Circle::new(c.center, c.radius + reach(c, v))),
         );
         self.found.clear();
-        find_contacts(
-            &self.inflated,
-            BroadPhase::Grid,
-            &mut self.grid,
-            &mut self.found,
-        );
+        self.grid.rebuild(&self.inflated);
+        search_in_bands(&self.grid, &mut self.found, |grid, rows, found| {
+            grid.for_each_candidate_pair_in_rows(rows, |i, j, ci, cj| {
+                if circles_touch(ci, cj) {
+                    found.push((i.min(j), i.max(j)));
+                }
+            });
+        });
         self.touching.clear();
         self.touching.resize(circles.len(), false);
         self.near.clear();
@@ -104,23 +107,23 @@ impl NearPairs {
         self.wall_impulse_of.clear();
         self.wall_impulse_of.resize(circles.len(), 0.0);
         self.pairs.clear();
-        for contact in &self.found {
-            let (a, b) = (circles[contact.a as usize], circles[contact.b as usize]);
+        for &(index_a, index_b) in &self.found {
+            let (a, b) = (circles[index_a as usize], circles[index_b as usize]);
             let offset = b.center - a.center;
             let distance = offset.length();
             let gap = distance - (a.radius + b.radius);
             let touching = within_margin(gap, a.radius + b.radius);
             self.pairs.push(NearPair {
-                a: contact.a,
-                b: contact.b,
+                a: index_a,
+                b: index_b,
                 gap,
                 normal: contact_normal(offset, distance),
                 touching,
             });
-            self.touching[contact.a as usize] |= touching;
-            self.touching[contact.b as usize] |= touching;
-            self.near[contact.a as usize] = true;
-            self.near[contact.b as usize] = true;
+            self.touching[index_a as usize] |= touching;
+            self.touching[index_b as usize] |= touching;
+            self.near[index_a as usize] = true;
+            self.near[index_b as usize] = true;
         }
         self.walls.clear();
         for (index, (circle, velocity)) in circles.iter().zip(velocities).enumerate() {

@@ -29,10 +29,19 @@ fn mechanical_energy(bodies: &[Body], velocity_of: impl Fn(usize) -> DVec2, grav
 /// mechanical energy: each overlap's spring energy (stiffness `omega`, radians per second,
 /// carried by the heavier movable side) and each movable body's weight times its overlaps
 /// (the height a push-out may lift it).
-fn overlap_allowance(bodies: &[Body], contacts: &[RestingContact], gravity: DVec2, omega: f64) -> f64 {
+fn overlap_allowance(
+    bodies: &[Body],
+    contacts: &[RestingContact],
+    gravity: DVec2,
+    omega: f64,
+) -> f64 {
     let mass = |index: u32| {
         let inverse_mass = bodies[index as usize].inverse_mass;
-        if inverse_mass > 0.0 { 1.0 / inverse_mass } else { 0.0 }
+        if inverse_mass > 0.0 {
+            1.0 / inverse_mass
+        } else {
+            0.0
+        }
     };
     let mut allowance = 0.0;
     for contact in contacts.iter().filter(|contact| contact.separation < 0.0) {
@@ -107,7 +116,11 @@ mod tests {
         let start = [DVec2::new(10.0, 0.0)];
         let taken = keep_energy(&mut bodies, &start, &[], GRAVITY, 90.0);
         assert!((taken - 1500.0).abs() < 1e-9, "{taken}");
-        assert!((bodies[0].velocity.x - 10.0).abs() < 1e-12, "{}", bodies[0].velocity);
+        assert!(
+            (bodies[0].velocity.x - 10.0).abs() < 1e-12,
+            "{}",
+            bodies[0].velocity
+        );
     }
 
     #[test]

@@ -38,13 +38,14 @@ mod islands;
 mod sleep;
 pub mod solver;
 mod state;
+mod wide;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use self::energy::keep_energy;
 pub use self::islands::Islands;
 pub use self::sleep::{SLEEP_SPEED, TIME_TO_SLEEP};
-use self::energy::keep_energy;
 use self::solver::{Other, RestingContact, SoftStep, soft_step};
 use self::state::MotionKey;
 pub use self::state::RestingState;

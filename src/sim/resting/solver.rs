@@ -1,14 +1,13 @@
 //! The resting-contact solver: Box2D v3's soft step over plain arrays. Pure: bodies and
 //! contacts in, new velocities, positions and contact impulses out.
 //!
-//! A step is split into substeps; each substep is the same short list of named passes as
-//! Box2D's `solver.c` (methods of `Work`): `integrate_velocities` (gravity, damping),
-//! `warm_start` (the impulses the contacts carried last substep), `solve_contacts` with a soft
-//! bias that pushes overlaps out at a capped speed, `integrate_positions`, and
-//! `relax_contacts` (the same solve without the bias, so the push-out leaves no velocity
-//! behind); then, once per step, `apply_restitution` to the contacts that closed at the
-//! resting speed or faster (the resting rule: slower ones do not bounce) and did not begin
-//! the step deep in an overlap.
+//! `Work` gathers the bodies the contacts touch into slots and each contact into a `Link`;
+//! the substeps run in [`wide`](super::wide), four contacts at a time, each the same short
+//! list of passes as Box2D's `solver.c` (velocities, warm start, a solve with a soft bias
+//! that pushes overlaps out at a capped speed, positions, and a relax without it); then,
+//! once per step, `apply_restitution` bounces the contacts that closed at the resting speed
+//! or faster (the resting rule: slower ones do not bounce) and did not begin the step deep
+//! in an overlap.
 //!
 //! Soft contacts (a spring of `hertz` with damping ratio `damping_ratio`, Box2D's
 //! `b2MakeSoft`) and warm starting are what let a deep pile hold still with a few
@@ -17,6 +16,7 @@
 use bevy::math::DVec2;
 
 pub use super::constraint::{Body, Other, RestingContact};
+use super::wide::{Link, Motion, Softness, WideStep};
 
 /// The soft step's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,28 +38,6 @@ pub struct SoftStep {
     pub rest_speed: f64,
 }
 
-/// A soft constraint's coefficients for a substep (Box2D's `b2Softness`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Softness {
-    bias_rate: f64,
-    mass_scale: f64,
-    impulse_scale: f64,
-}
-
-impl Softness {
-    fn new(hertz: f64, damping_ratio: f64, h: f64) -> Self {
-        let omega = 2.0 * std::f64::consts::PI * hertz;
-        let a1 = 2.0 * damping_ratio + h * omega;
-        let a2 = h * omega * a1;
-        let a3 = 1.0 / (1.0 + a2);
-        Self {
-            bias_rate: omega / a1,
-            mass_scale: a2 * a3,
-            impulse_scale: a3,
-        }
-    }
-}
-
 /// One soft step of `bodies` held by `contacts`. Bodies with inverse mass 0 stay put.
 pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: SoftStep) {
     let substeps = step.substeps.max(1);
@@ -71,16 +49,10 @@ pub fn soft_step(bodies: &mut [Body], contacts: &mut [RestingContact], step: Sof
         contact.bounced = false;
         contact.closing_velocity = work.speed_at_contact(link, step.gravity);
     }
-    for _ in 0..substeps {
-        work.integrate_velocities(step.gravity * h, decay);
-        work.warm_start();
-        work.solve_contacts(h, Some((softness, step.max_push_speed)));
-        work.integrate_positions(h);
-        work.relax_contacts(h);
-        for link in &mut work.links {
-            link.step_impulse += link.impulse;
-        }
-    }
+    let mut wide = WideStep::new(&work.motion, &work.inverse_mass, &work.links);
+    let bias = (softness, step.max_push_speed);
+    wide.run(substeps, h, step.gravity * h, decay, bias);
+    wide.finish(&mut work.motion, &mut work.links);
     for (contact, link) in contacts.iter_mut().zip(&work.links) {
         contact.step_impulse = link.step_impulse;
     }
@@ -113,29 +85,6 @@ struct Work {
     links: Vec<Link>,
     /// Each body's slot, or [`NO_SLOT`].
     slot_of: Vec<u32>,
-}
-
-/// A body's velocity and how far it has moved, side by side: what every contact reads.
-#[derive(Clone, Copy, Debug, Default)]
-struct Motion {
-    velocity: DVec2,
-    shift: DVec2,
-}
-
-/// What a pass reads of a contact, packed: its two slots, their inverse masses and its
-/// effective mass (0 if neither side moves), normal, starting gap and impulse.
-struct Link {
-    a: u32,
-    b: u32,
-    inverse_mass_a: f64,
-    inverse_mass_b: f64,
-    mass: f64,
-    normal: DVec2,
-    separation: f64,
-    impulse: f64,
-    /// The impulse summed over the step's substeps.
-    step_impulse: f64,
-    push_out: bool,
 }
 
 impl Work {
@@ -229,59 +178,6 @@ impl Work {
         -(speed * speed - 2.0 * accel * link.separation)
             .max(0.0)
             .sqrt()
-    }
-
-    fn integrate_velocities(&mut self, gain: DVec2, decay: f64) {
-        for (motion, &inverse_mass) in self.motion.iter_mut().zip(&self.inverse_mass) {
-            if inverse_mass > 0.0 {
-                motion.velocity = (motion.velocity + gain) * decay;
-            }
-        }
-    }
-
-    fn warm_start(&mut self) {
-        for link in &self.links {
-            Self::apply_impulse(&mut self.motion, link, link.impulse);
-        }
-    }
-
-    fn integrate_positions(&mut self, h: f64) {
-        for (motion, &inverse_mass) in self.motion.iter_mut().zip(&self.inverse_mass) {
-            if inverse_mass > 0.0 {
-                motion.shift += motion.velocity * h;
-            }
-        }
-    }
-
-    fn relax_contacts(&mut self, h: f64) {
-        self.solve_contacts(h, None);
-    }
-
-    /// One Gauss–Seidel pass over the contacts. With `bias` (the soft coefficients and the
-    /// push-out cap) an overlap is pushed out softly; without, only the approach is removed.
-    /// A gap still open (a speculative contact) may close within the substep but not beyond.
-    fn solve_contacts(&mut self, h: f64, bias: Option<(Softness, f64)>) {
-        let motion = &mut self.motion;
-        for link in self.links.iter_mut().filter(|link| link.mass > 0.0) {
-            let (a, b) = (motion[link.a as usize], motion[link.b as usize]);
-            let separation = link.separation + (b.shift - a.shift).dot(link.normal);
-            let normal_speed = (b.velocity - a.velocity).dot(link.normal);
-            let (push, mass_scale, impulse_scale) = match bias {
-                _ if separation > 0.0 => (separation / h, 1.0, 0.0),
-                Some((soft, max_push_speed)) if link.push_out => (
-                    (soft.bias_rate * separation).max(-max_push_speed),
-                    soft.mass_scale,
-                    soft.impulse_scale,
-                ),
-                _ => (0.0, 1.0, 0.0),
-            };
-            let change =
-                -(normal_speed + push) * mass_scale * link.mass - impulse_scale * link.impulse;
-            let total = (link.impulse + change).max(0.0);
-            let applied = total - link.impulse;
-            link.impulse = total;
-            Self::apply_impulse(motion, link, applied);
-        }
     }
 
     /// Contacts that closed at `rest_speed` or faster when the step began, and that the
