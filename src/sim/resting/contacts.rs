@@ -140,19 +140,20 @@ impl NearPairs {
         }
     }
 
-    /// The solver's bodies (the `solved` balls movable, every other an anchor that stands
-    /// still for it: the mode's stages move those) and the contacts that involve a solved
-    /// ball, warm-started from `warm`.
+    /// Fills `bodies` with the solver's bodies (the `solved` balls movable, every other an
+    /// anchor that stands still for it: the mode's stages move those) and `contacts` with
+    /// the contacts that involve a solved ball, warm-started from `warm`.
+    #[allow(clippy::too_many_arguments)]
     pub fn solver_input(
         &mut self,
-        circles: &[Circle],
-        velocities: &[DVec2],
-        entities: &[Entity],
+        (circles, velocities, entities): (&[Circle], &[DVec2], &[Entity]),
         solved: impl Fn(usize) -> bool,
         mass_model: MassModel,
         warm: &HashMap<(u64, u64), f64>,
-    ) -> (Vec<Body>, Vec<RestingContact>) {
-        let bodies = circles
+        (bodies, contacts): (&mut Vec<Body>, &mut Vec<RestingContact>),
+    ) {
+        bodies.clear();
+        bodies.extend(circles
             .iter()
             .zip(velocities)
             .enumerate()
@@ -166,9 +167,8 @@ impl NearPairs {
                 } else {
                     Body::new(circle.center, DVec2::ZERO, 0.0)
                 }
-            })
-            .collect();
-        let mut contacts = Vec::with_capacity(self.pairs.len() + self.walls.len());
+            }));
+        contacts.clear();
         for &NearPair {
             a, b, gap, normal, ..
         } in &self.pairs
@@ -197,7 +197,6 @@ impl NearPairs {
                 contacts.push(contact);
             }
         }
-        (bodies, contacts)
     }
 
     /// Each solved contact's impulse under its key, for the next step's warm start; and the

@@ -40,13 +40,15 @@ pub mod solver;
 mod state;
 mod wide;
 
+use std::mem::take;
+
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use self::energy::keep_energy;
 pub use self::islands::Islands;
 pub use self::sleep::{SLEEP_SPEED, TIME_TO_SLEEP};
-use self::solver::{Other, RestingContact, SoftStep, soft_step};
+use self::solver::{Body, Other, RestingContact, SoftStep, soft_step};
 use self::state::MotionKey;
 pub use self::state::RestingState;
 use super::ball::{Ball, BallSnapshot, Position, Rest, RestState, Velocity};
@@ -190,17 +192,33 @@ fn solve(
 ) -> f64 {
     let solved =
         |index: usize| state.rests[index].state == RestState::Resting && snapshot.held[index];
-    let (mut bodies, mut contacts) = state.near.solver_input(
-        &snapshot.circles,
-        &snapshot.velocities,
-        &snapshot.entities,
+    let (mut bodies, mut contacts) = (take(&mut state.bodies), take(&mut state.contacts));
+    state.near.solver_input(
+        (&snapshot.circles, &snapshot.velocities, &snapshot.entities),
         solved,
         params.mass_model,
         &state.warm,
+        (&mut bodies, &mut contacts),
     );
-    if contacts.is_empty() && bodies.iter().all(|body| body.inverse_mass == 0.0) {
-        return 0.0;
-    }
+    let load = if contacts.is_empty() && bodies.iter().all(|body| body.inverse_mass == 0.0) {
+        0.0
+    } else {
+        solve_bodies(state, snapshot, params, (dt, rest_speed), (&mut bodies, &mut contacts), log)
+    };
+    (state.bodies, state.contacts) = (bodies, contacts);
+    load
+}
+
+/// Step 3 proper: the soft step of `bodies` held by `contacts` (the solver's input), written
+/// back to the snapshot. Returns the walls' impulse on them.
+fn solve_bodies(
+    state: &mut RestingState,
+    snapshot: &mut BallSnapshot,
+    params: &SimParams,
+    (dt, rest_speed): (f64, f64),
+    (bodies, contacts): (&mut Vec<Body>, &mut Vec<RestingContact>),
+    log: &mut StepLog,
+) -> f64 {
     let step = SoftStep {
         dt,
         substeps: SUBSTEPS,
@@ -212,12 +230,13 @@ fn solve(
         restitution: params.restitution,
         rest_speed,
     };
-    let start: Vec<DVec2> = bodies.iter().map(|body| body.velocity).collect();
-    soft_step(&mut bodies, &mut contacts, step);
-    log_bounces(&contacts, snapshot, params, dt, log);
+    state.start.clear();
+    state.start.extend(bodies.iter().map(|body| body.velocity));
+    soft_step(bodies, contacts, step, &mut state.memory);
+    log_bounces(contacts, snapshot, params, dt, log);
     let warm = state
         .near
-        .warm_starts(&contacts, &snapshot.entities)
+        .warm_starts(contacts, &snapshot.entities)
         .collect();
     state.warm = warm;
     let half = params.half_extents();
@@ -235,7 +254,7 @@ fn solve(
         stop_impulse += (body.velocity - velocity).length() / body.inverse_mass;
         (body.shift, body.velocity) = (center - body.position, velocity);
     }
-    keep_energy(&mut bodies, &start, &contacts, params.gravity, step.hertz);
+    keep_energy(bodies, &state.start, contacts, params.gravity, step.hertz);
     for (index, body) in bodies.iter().enumerate() {
         if body.inverse_mass > 0.0 {
             snapshot.circles[index].center = body.position + body.shift;

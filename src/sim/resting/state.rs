@@ -8,6 +8,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::contacts::NearPairs;
+use super::solver::{Body, RestingContact, SolverMemory};
 use crate::sim::ball::Rest;
 use crate::sim::params::{CollisionMode, MassModel};
 
@@ -38,4 +39,10 @@ pub struct RestingState {
     pub(super) next_island: u32,
     pub(super) near: NearPairs,
     pub(super) rests: Vec<Rest>,
+    /// The solver's input and working memory, kept between steps so a step allocates
+    /// nothing: its bodies, its contacts, each body's velocity when the step began.
+    pub(super) bodies: Vec<Body>,
+    pub(super) contacts: Vec<RestingContact>,
+    pub(super) start: Vec<DVec2>,
+    pub(super) memory: SolverMemory,
 }

@@ -40,6 +40,7 @@ pub(super) struct Motion {
 
 /// What a pass reads of a contact, packed: its two slots, their inverse masses and its
 /// effective mass (0 if neither side moves), normal, starting gap and impulse.
+#[derive(Debug)]
 pub(super) struct Link {
     pub a: u32,
     pub b: u32,
@@ -79,43 +80,43 @@ pub struct WideLink {
 }
 
 /// The substeps' state: each slot's `[vx, vy, shift x, shift y]` and whether it moves, and
-/// the links in wide groups, colour after colour.
+/// the links in wide groups, colour after colour; with the colouring's scratch arrays, kept
+/// for the next step.
+#[derive(Debug, Default)]
 pub struct WideStep {
     states: Vec<Vec4>,
     movable: Vec<bool>,
     links: Vec<WideLink>,
+    colouring: Colouring,
 }
 
 impl WideStep {
-    /// The slots' `motion` and `inverse_mass` (the last slot is the anchor) and the `links`
-    /// between them.
-    pub fn new(motion: &[Motion], inverse_mass: &[f64], links: &[Link]) -> Self {
+    /// Fills the state for the slots' `motion` and `inverse_mass` (the last slot is the
+    /// anchor) and the `links` between them.
+    pub fn fill(&mut self, motion: &[Motion], inverse_mass: &[f64], links: &[Link]) {
         let anchor = (motion.len() - 1) as u32;
-        let states = motion
-            .iter()
-            .map(|m| {
-                Vec4::new(
-                    m.velocity.x as f32,
-                    m.velocity.y as f32,
-                    m.shift.x as f32,
-                    m.shift.y as f32,
-                )
-            })
-            .collect();
-        let movable = inverse_mass.iter().map(|&im| im > 0.0).collect();
-        let solvable: Vec<u32> = (0..links.len() as u32)
-            .filter(|&index| links[index as usize].mass > 0.0)
-            .collect();
-        let (order, groups) = group_by_colour(&solvable, links, anchor, motion.len());
-        let wide = groups
-            .into_iter()
-            .map(|group| pack(&order[group], links, anchor))
-            .collect();
-        Self {
-            states,
-            movable,
-            links: wide,
-        }
+        self.states.clear();
+        self.states.extend(motion.iter().map(|m| {
+            Vec4::new(
+                m.velocity.x as f32,
+                m.velocity.y as f32,
+                m.shift.x as f32,
+                m.shift.y as f32,
+            )
+        }));
+        self.movable.clear();
+        self.movable.extend(inverse_mass.iter().map(|&im| im > 0.0));
+        let colouring = &mut self.colouring;
+        colouring.solvable.clear();
+        colouring
+            .solvable
+            .extend((0..links.len() as u32).filter(|&index| links[index as usize].mass > 0.0));
+        colouring.group(links, anchor, motion.len());
+        self.links.clear();
+        (self.links).extend(
+            (colouring.groups.iter())
+                .map(|group| pack(&colouring.order[group.clone()], links, anchor)),
+        );
     }
 
     /// The substeps of the soft step, each the passes of Box2D's `solver.c`: velocities
@@ -268,24 +269,33 @@ fn apply(a: &mut Sides, b: &mut Sides, link: &WideLink, impulse: Vec4) {
     b.velocity_y += push_y * link.inverse_mass_b;
 }
 
-/// The links `solvable` (indices into `links`) in groups of at most four, colour after
-/// colour: `order` lists them, and each group is a range of it. Within a group no two
-/// links share a movable slot (the `anchor`, which never moves, may be shared). Greedy
-/// colouring, each link the lowest colour neither of its slots has; a link whose slots have
-/// all [`COLOURS`] goes in a group of its own, last.
-fn group_by_colour(
-    solvable: &[u32],
-    links: &[Link],
-    anchor: u32,
-    slots: usize,
-) -> (Vec<u32>, Vec<Range<usize>>) {
-    let mut used = vec![0u32; slots];
-    let mut count = [0usize; COLOURS as usize + 1];
-    let colours: Vec<u32> = solvable
-        .iter()
-        .map(|&index| {
+/// The colouring's arrays: the links to colour (`solvable`, indices into the links) in,
+/// `order` and `groups` out.
+#[derive(Debug, Default)]
+struct Colouring {
+    solvable: Vec<u32>,
+    /// Each slot's colours taken, a bit each.
+    used: Vec<u32>,
+    colours: Vec<u32>,
+    order: Vec<u32>,
+    groups: Vec<Range<usize>>,
+}
+
+impl Colouring {
+    /// Puts the `solvable` links in groups of at most four, colour after colour: `order`
+    /// lists them, and each group is a range of it. Within a group no two links share a
+    /// movable slot (the `anchor`, which never moves, may be shared). Greedy colouring, each
+    /// link the lowest colour neither of its slots has; a link whose slots have all
+    /// [`COLOURS`] goes in a group of its own, last.
+    fn group(&mut self, links: &[Link], anchor: u32, slots: usize) {
+        self.used.clear();
+        self.used.resize(slots, 0);
+        let mut count = [0usize; COLOURS as usize + 1];
+        self.colours.clear();
+        for &index in &self.solvable {
             let link = &links[index as usize];
             let movable_b = link.b != anchor;
+            let used = &mut self.used;
             let taken = used[link.a as usize] | if movable_b { used[link.b as usize] } else { 0 };
             let colour = taken.trailing_ones().min(COLOURS);
             if colour < COLOURS {
@@ -295,31 +305,27 @@ fn group_by_colour(
                 }
             }
             count[colour as usize] += 1;
-            colour
-        })
-        .collect();
-    let mut start = [0usize; COLOURS as usize + 2];
-    for colour in 0..=COLOURS as usize {
-        start[colour + 1] = start[colour] + count[colour];
+            self.colours.push(colour);
+        }
+        let mut start = [0usize; COLOURS as usize + 2];
+        for colour in 0..=COLOURS as usize {
+            start[colour + 1] = start[colour] + count[colour];
+        }
+        let mut next = start;
+        self.order.clear();
+        self.order.resize(self.solvable.len(), 0);
+        for (&index, &colour) in self.solvable.iter().zip(&self.colours) {
+            self.order[next[colour as usize]] = index;
+            next[colour as usize] += 1;
+        }
+        self.groups.clear();
+        for colour in 0..COLOURS as usize {
+            let (first, end) = (start[colour], start[colour + 1]);
+            (self.groups).extend((first..end).step_by(LANES).map(|at| at..(at + LANES).min(end)));
+        }
+        let overflow = start[COLOURS as usize]..start[COLOURS as usize + 1];
+        self.groups.extend(overflow.map(|at| at..at + 1));
     }
-    let mut next = start;
-    let mut order = vec![0; solvable.len()];
-    for (&index, &colour) in solvable.iter().zip(&colours) {
-        order[next[colour as usize]] = index;
-        next[colour as usize] += 1;
-    }
-    let mut groups = Vec::with_capacity(solvable.len() / LANES + COLOURS as usize);
-    for colour in 0..COLOURS as usize {
-        let (first, end) = (start[colour], start[colour + 1]);
-        groups.extend(
-            (first..end)
-                .step_by(LANES)
-                .map(|at| at..(at + LANES).min(end)),
-        );
-    }
-    let overflow = start[COLOURS as usize]..start[COLOURS as usize + 1];
-    groups.extend(overflow.map(|at| at..at + 1));
-    (order, groups)
 }
 
 /// A group's links packed into lanes, the empty lanes pointing at the `anchor` with no mass.
@@ -354,6 +360,7 @@ fn pack(group: &[u32], links: &[Link], anchor: u32) -> WideLink {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bevy::prelude::default;
 
     fn link(a: u32, b: u32) -> Link {
         Link {
@@ -378,8 +385,15 @@ mod tests {
         links.extend((0..30).map(|k| link(k, anchor)));
         links.extend((2..30).map(|k| link(0, k)));
         let all: Vec<u32> = (0..links.len() as u32).collect();
-        let (order, ranges) = group_by_colour(&all, &links, anchor, 31);
-        let groups: Vec<&[u32]> = ranges.into_iter().map(|range| &order[range]).collect();
+        let mut colouring = Colouring {
+            solvable: all.clone(),
+            ..default()
+        };
+        colouring.group(&links, anchor, 31);
+        let order = &colouring.order;
+        let groups: Vec<&[u32]> = (colouring.groups.iter())
+            .map(|range| &order[range.clone()])
+            .collect();
         let mut seen: Vec<u32> = groups.iter().copied().flatten().copied().collect();
         seen.sort_unstable();
         assert_eq!(seen, all);
