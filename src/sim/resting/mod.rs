@@ -234,11 +234,9 @@ fn solve_bodies(
     state.start.extend(bodies.iter().map(|body| body.velocity));
     soft_step(bodies, contacts, step, &mut state.memory);
     log_bounces(contacts, snapshot, params, dt, log);
-    let warm = state
-        .near
-        .warm_starts(contacts, &snapshot.entities)
-        .collect();
-    state.warm = warm;
+    // Refilled in place, like the solver's memory.
+    state.warm.clear();
+    (state.warm).extend(state.near.warm_starts(contacts, &snapshot.entities));
     let half = params.half_extents();
     let mut stop_impulse = 0.0;
     for (body, circle) in bodies.iter_mut().zip(&snapshot.circles) {
