@@ -143,7 +143,6 @@ impl NearPairs {
     /// Fills `bodies` with the solver's bodies (the `solved` balls movable, every other an
     /// anchor that stands still for it: the mode's stages move those) and `contacts` with
     /// the contacts that involve a solved ball, warm-started from `warm`.
-    #[allow(clippy::too_many_arguments)]
     pub fn solver_input(
         &mut self,
         (circles, velocities, entities): (&[Circle], &[DVec2], &[Entity]),
@@ -153,11 +152,8 @@ impl NearPairs {
         (bodies, contacts): (&mut Vec<Body>, &mut Vec<RestingContact>),
     ) {
         bodies.clear();
-        bodies.extend(circles
-            .iter()
-            .zip(velocities)
-            .enumerate()
-            .map(|(index, (circle, velocity))| {
+        bodies.extend(circles.iter().zip(velocities).enumerate().map(
+            |(index, (circle, velocity))| {
                 if solved(index) {
                     Body::new(
                         circle.center,
@@ -167,7 +163,8 @@ impl NearPairs {
                 } else {
                     Body::new(circle.center, DVec2::ZERO, 0.0)
                 }
-            }));
+            },
+        ));
         contacts.clear();
         for &NearPair {
             a, b, gap, normal, ..

@@ -20,7 +20,7 @@
 //!    soft step of [`solver`] with their contacts (balls that are not resting are
 //!    immovable anchors for it); the walls' impulses count towards the pressure, and the
 //!    bounces it applies are hits; a ball it carried past a wall is put back and stopped
-//!    there, and [`energy`]'s guard takes back any mechanical energy the step gained beyond
+//!    there, and `energy.rs`'s guard takes back any mechanical energy the step gained beyond
 //!    what its overlaps could release;
 //! 4. `classify`: who rests next step, by mode (its comment says how);
 //! 5. `fall_asleep`: islands of touching resting balls, each ball slower than
@@ -203,7 +203,14 @@ fn solve(
     let load = if contacts.is_empty() && bodies.iter().all(|body| body.inverse_mass == 0.0) {
         0.0
     } else {
-        solve_bodies(state, snapshot, params, (dt, rest_speed), (&mut bodies, &mut contacts), log)
+        solve_bodies(
+            state,
+            snapshot,
+            params,
+            (dt, rest_speed),
+            (&mut bodies, &mut contacts),
+            log,
+        )
     };
     (state.bodies, state.contacts) = (bodies, contacts);
     load

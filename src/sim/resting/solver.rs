@@ -2,7 +2,7 @@
 //! contacts in, new velocities, positions and contact impulses out.
 //!
 //! `Work` gathers the bodies the contacts touch into slots and each contact into a `Link`;
-//! the substeps run in [`wide`](super::wide), four contacts at a time, each the same short
+//! the substeps run in `wide.rs`, four contacts at a time, each the same short
 //! list of passes as Box2D's `solver.c` (velocities, warm start, a solve with a soft bias
 //! that pushes overlaps out at a capped speed, positions, and a relax without it); then,
 //! once per step, `apply_restitution` bounces the contacts that closed at the resting speed
@@ -347,7 +347,12 @@ mod tests {
         ];
         // 1 px apart, closing at 200 px/s: 3.3 px a step would overshoot by 2.3 px.
         let mut contacts = vec![RestingContact::new(1, Other::Body(0), DVec2::Y, 1.0, 0.0)];
-        soft_step(&mut bodies, &mut contacts, STEP, &mut SolverMemory::default());
+        soft_step(
+            &mut bodies,
+            &mut contacts,
+            STEP,
+            &mut SolverMemory::default(),
+        );
         let gap = 1.0 + (bodies[0].shift - bodies[1].shift).dot(DVec2::Y);
         assert!((-1e-3..0.2).contains(&gap), "{gap}");
         assert_eq!(bodies[1].shift, DVec2::ZERO);
@@ -374,7 +379,12 @@ mod tests {
                 RestingContact::new(0, Other::Wall(Wall::Bottom), DVec2::NEG_Y, -3.0, 0.0);
             contact.may_bounce = may_bounce;
             let mut contacts = vec![contact];
-            soft_step(&mut bodies, &mut contacts, STEP, &mut SolverMemory::default());
+            soft_step(
+                &mut bodies,
+                &mut contacts,
+                STEP,
+                &mut SolverMemory::default(),
+            );
             (bodies[0].velocity.y, contacts[0].bounced)
         };
         let (bounced_speed, bounced) = run(true);

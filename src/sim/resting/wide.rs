@@ -321,7 +321,11 @@ impl Colouring {
         self.groups.clear();
         for colour in 0..COLOURS as usize {
             let (first, end) = (start[colour], start[colour + 1]);
-            (self.groups).extend((first..end).step_by(LANES).map(|at| at..(at + LANES).min(end)));
+            (self.groups).extend(
+                (first..end)
+                    .step_by(LANES)
+                    .map(|at| at..(at + LANES).min(end)),
+            );
         }
         let overflow = start[COLOURS as usize]..start[COLOURS as usize + 1];
         self.groups.extend(overflow.map(|at| at..at + 1));
