@@ -1,0 +1,212 @@
+//! peers: runs a ballpit scene file in Box2D v3 and rapier, each set up as its users would
+//! (`box2d.rs`, `rapier.rs` say how), and prints what `ballpit run --json` prints of the
+//! same run: ms per step, energy, momentum, overlaps, balls escaped and still moving. Not
+//! built by `cargo test` or CI: `cargo run --release -p peers -- --scene FILE`.
+
+mod box2d;
+mod rapier;
+mod scene;
+
+use std::time::Instant;
+
+use ballpit::sim::geometry::circle::Circle;
+use ballpit::sim::measure::summary::overlaps_rel;
+use ballpit::sim::{SimParams, StateSummary};
+use clap::{Parser, ValueEnum};
+use serde::Serialize;
+
+use scene::{Ball, Scene};
+
+/// What the harness needs of an engine; pixels and pixels per second across it.
+pub trait Engine {
+    /// One step of the scene's `dt`.
+    fn step(&mut self);
+    /// The balls now, in the scene's order.
+    fn balls(&mut self) -> Vec<Ball>;
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+enum Engines {
+    Box2d,
+    Rapier,
+    All,
+}
+
+#[derive(Parser)]
+#[command(about = "Runs a ballpit scene file in Box2D v3 and rapier")]
+struct Cli {
+    /// The scene file (RON), as `ballpit run --scene` reads it.
+    #[arg(long)]
+    scene: String,
+    /// Override the scene's generated ball count.
+    #[arg(long)]
+    balls: Option<usize>,
+    /// Override the scene's generation seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Steps to run (of the scene's 1/60 s).
+    #[arg(long, default_value_t = 600)]
+    steps: u64,
+    /// Untimed steps at the start (still run).
+    #[arg(long, default_value_t = 0)]
+    warmup: u64,
+    #[arg(long, value_enum, default_value = "all")]
+    engine: Engines,
+    /// One JSON object per engine and line instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The fields `ballpit run --json` reports that an engine can: the same names, the same
+/// meanings.
+#[derive(Serialize)]
+struct Report {
+    engine: &'static str,
+    balls: usize,
+    arena: [f64; 2],
+    steps: u64,
+    dt_s: f64,
+    sim_time_s: f64,
+    ms_per_step_median: f64,
+    ms_per_step_mean: f64,
+    kinetic_energy_start: f64,
+    kinetic_energy_end: f64,
+    kinetic_energy_change_rel: f64,
+    mechanical_energy_start: f64,
+    mechanical_energy_end: f64,
+    mechanical_energy_change_rel: f64,
+    momentum_start: [f64; 2],
+    momentum_end: [f64; 2],
+    max_overlap_rel: f64,
+    mean_overlap_rel: f64,
+    moving: usize,
+    rms_speed: f64,
+    escaped: usize,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let scene = match Scene::load(&cli.scene, cli.balls, cli.seed) {
+        Ok(scene) => scene,
+        Err(error) => {
+            eprintln!("peers: {error}");
+            std::process::exit(1);
+        }
+    };
+    let kinds: &[&'static str] = match cli.engine {
+        Engines::Box2d => &["box2d"],
+        Engines::Rapier => &["rapier"],
+        Engines::All => &["box2d", "rapier"],
+    };
+    if !cli.json {
+        println!(
+            "engine    balls  steps  ms/step mean  median  energy change  overlap max / mean  moving  escaped"
+        );
+    }
+    for &kind in kinds {
+        let mut engine: Box<dyn Engine> = match kind {
+            "box2d" => Box::new(box2d::Box2d::new(&scene).expect("box2d world")),
+            _ => Box::new(rapier::Rapier::new(&scene)),
+        };
+        let report = run(kind, engine.as_mut(), &scene, cli.steps, cli.warmup);
+        if cli.json {
+            println!(
+                "{}",
+                serde_json::to_string(&report).expect("a report serialises")
+            );
+        } else {
+            println!(
+                "{:<8} {:>6} {:>6}  {:>12.3}  {:>6.3}  {:>13.3e}  {:>8.3} / {:<7.4}  {:>6}  {:>7}",
+                report.engine,
+                report.balls,
+                report.steps,
+                report.ms_per_step_mean,
+                report.ms_per_step_median,
+                report.mechanical_energy_change_rel,
+                report.max_overlap_rel,
+                report.mean_overlap_rel,
+                report.moving,
+                report.escaped
+            );
+        }
+    }
+}
+
+/// Runs `steps` steps of `engine`, timing each after the first `warmup`, and measures the
+/// start and the end as ballpit does (its own measuring code, in its coordinates).
+fn run(
+    name: &'static str,
+    engine: &mut dyn Engine,
+    scene: &Scene,
+    steps: u64,
+    warmup: u64,
+) -> Report {
+    let start = measure(scene, &scene.balls);
+    let mut times = Vec::with_capacity(steps as usize);
+    for step in 0..steps {
+        let started = Instant::now();
+        engine.step();
+        if step >= warmup {
+            times.push(started.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    let balls = engine.balls();
+    let end = measure(scene, &balls);
+    let circles: Vec<Circle> = balls
+        .iter()
+        .map(|ball| Circle::new(ball.position, ball.radius))
+        .collect();
+    let (max_overlap_rel, mean_overlap_rel) = overlaps_rel(&circles);
+    let change = |start: f64, end: f64| (end - start) / start.abs();
+    Report {
+        engine: name,
+        balls: balls.len(),
+        arena: scene.size.to_array(),
+        steps,
+        dt_s: scene.dt,
+        sim_time_s: scene.dt * steps as f64,
+        ms_per_step_median: median(&mut times),
+        ms_per_step_mean: times.iter().sum::<f64>() / times.len().max(1) as f64,
+        kinetic_energy_start: start.kinetic_energy,
+        kinetic_energy_end: end.kinetic_energy,
+        kinetic_energy_change_rel: change(start.kinetic_energy, end.kinetic_energy),
+        mechanical_energy_start: start.mechanical_energy,
+        mechanical_energy_end: end.mechanical_energy,
+        mechanical_energy_change_rel: change(start.mechanical_energy, end.mechanical_energy),
+        momentum_start: start.momentum.to_array(),
+        momentum_end: end.momentum.to_array(),
+        max_overlap_rel,
+        mean_overlap_rel,
+        moving: end.moving,
+        rms_speed: end.rms_speed,
+        escaped: end.escaped,
+    }
+}
+
+/// ballpit's summary of `balls`, moved back into its centred arena.
+fn measure(scene: &Scene, balls: &[Ball]) -> StateSummary {
+    let params = SimParams {
+        arena_size: scene.size,
+        gravity: scene.gravity,
+        mass_model: scene.mass_model,
+        ..SimParams::default()
+    };
+    let half = scene.size / 2.0;
+    let centred = balls
+        .iter()
+        .map(|ball| (ball.position - half, ball.velocity, ball.radius));
+    StateSummary::of_balls(centred, &params, &mut Vec::new())
+}
+
+fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let middle = values.len() / 2;
+    if values.len() % 2 == 0 {
+        (values[middle - 1] + values[middle]) / 2.0
+    } else {
+        values[middle]
+    }
+}
