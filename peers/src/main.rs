@@ -9,6 +9,7 @@ mod scene;
 
 use std::time::Instant;
 
+use ballpit::commands::observe::dump::{DumpedBall, StateDump};
 use ballpit::sim::geometry::circle::Circle;
 use ballpit::sim::measure::summary::overlaps_rel;
 use ballpit::sim::{SimParams, StateSummary};
@@ -55,6 +56,10 @@ struct Cli {
     /// One JSON object per engine and line instead of a table.
     #[arg(long)]
     json: bool,
+    /// Write each engine's final state to `DIR/ENGINE.json` in the format of `ballpit run
+    /// --dump` (ids in the scene's order).
+    #[arg(long, value_name = "DIR")]
+    dump: Option<std::path::PathBuf>,
 }
 
 /// The fields `ballpit run --json` reports that an engine can: the same names, the same
@@ -109,6 +114,15 @@ fn main() {
             _ => Box::new(rapier::Rapier::new(&scene)),
         };
         let report = run(kind, engine.as_mut(), &scene, cli.steps, cli.warmup);
+        if let Some(dir) = &cli.dump {
+            let path = dir.join(format!("{kind}.json"));
+            let written = std::fs::create_dir_all(dir)
+                .and_then(|()| std::fs::write(&path, dump(&scene, &engine.balls())));
+            if let Err(error) = written {
+                eprintln!("peers: {}: {error}", path.display());
+                std::process::exit(1);
+            }
+        }
         if cli.json {
             println!(
                 "{}",
@@ -181,6 +195,26 @@ fn run(
         rms_speed: end.rms_speed,
         escaped: end.escaped,
     }
+}
+
+/// `balls` as `ballpit run --dump` writes them: ids in the scene's order, ballpit's centred
+/// coordinates.
+fn dump(scene: &Scene, balls: &[Ball]) -> String {
+    let half = scene.size / 2.0;
+    let dump = StateDump {
+        balls: (balls.iter().enumerate())
+            .map(|(id, ball)| DumpedBall {
+                id: id as u32,
+                x: ball.position.x - half.x,
+                y: ball.position.y - half.y,
+                vx: ball.velocity.x,
+                vy: ball.velocity.y,
+                r: ball.radius,
+                m: scene.mass_model.mass(ball.radius),
+            })
+            .collect(),
+    };
+    serde_json::to_string_pretty(&dump).expect("a dump serialises")
 }
 
 /// ballpit's summary of `balls`, moved back into its centred arena.
