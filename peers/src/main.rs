@@ -10,6 +10,7 @@ mod scene;
 use std::time::Instant;
 
 use ballpit::commands::observe::dump::{DumpedBall, StateDump};
+use ballpit::headless::{mean, median};
 use ballpit::sim::geometry::circle::Circle;
 use ballpit::sim::measure::summary::overlaps_rel;
 use ballpit::sim::{SimParams, StateSummary};
@@ -180,7 +181,7 @@ fn run(
         dt_s: scene.dt,
         sim_time_s: scene.dt * steps as f64,
         ms_per_step_median: median(&mut times),
-        ms_per_step_mean: times.iter().sum::<f64>() / times.len().max(1) as f64,
+        ms_per_step_mean: mean(&times),
         kinetic_energy_start: start.kinetic_energy,
         kinetic_energy_end: end.kinetic_energy,
         kinetic_energy_change_rel: change(start.kinetic_energy, end.kinetic_energy),
@@ -230,17 +231,4 @@ fn measure(scene: &Scene, balls: &[Ball]) -> StateSummary {
         .iter()
         .map(|ball| (ball.position - half, ball.velocity, ball.radius));
     StateSummary::of_balls(centred, &params, &mut Vec::new())
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    values.sort_by(f64::total_cmp);
-    let middle = values.len() / 2;
-    if values.len() % 2 == 0 {
-        (values[middle - 1] + values[middle]) / 2.0
-    } else {
-        values[middle]
-    }
 }
