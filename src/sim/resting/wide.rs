@@ -60,7 +60,7 @@ const LANES: usize = 4;
 /// Colours tried before a link goes into a group of its own.
 const COLOURS: u32 = 24;
 
-/// Four links solved together: lane `k` is link `contact[k]` between slots `a[k]` and
+/// Four links solved together: lane `k` is link `link[k]` between slots `a[k]` and
 /// `b[k]`. A lane with no link points at the anchor with zero mass and does nothing.
 #[derive(Clone, Copy, Debug)]
 pub struct WideLink {
@@ -157,6 +157,8 @@ impl WideStep {
         }
     }
 
+    /// Each link's impulse from the substep before (the first substep: the step before)
+    /// applied again, so a contact carries its load from the start.
     fn warm_start(&mut self) {
         for link in &self.links {
             let (mut a, mut b) = gather(&self.states, link);
