@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
+use crate::commands::mixed::{format_mixed_table, run_mixed};
 use crate::commands::observe::dump::StateDump;
 use crate::commands::observe::{ObserveRequest, Observers};
 use crate::commands::pile::{format_pile_table, run_pile};
@@ -99,6 +100,11 @@ pub struct BenchArgs {
     /// restitution 0.5) in both modes instead of the gas [default sizes: 1000,10000].
     #[arg(long)]
     pub pile: bool,
+    /// Time mixed sizes (`assets/scenes/mixed.ron`: small balls and three big ones) against
+    /// the small balls alone, in both modes [default size: 5000 small balls; below about 1500
+    /// the arena is too small for the big ones].
+    #[arg(long, conflicts_with = "pile")]
+    pub mixed: bool,
     /// Run the all-pairs reference for sizes up to this (it is O(N^2)).
     #[arg(long, default_value_t = 10_000)]
     pub all_pairs_max: u64,
@@ -348,6 +354,9 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     if args.pile {
         return run_pile_bench(&args);
     }
+    if args.mixed {
+        return run_mixed_bench(&args);
+    }
     let mut rows = Vec::new();
     let sizes = args.sizes.clone().unwrap_or(vec![1_000, 10_000, 100_000]);
     let steps = args.steps.unwrap_or(200);
@@ -406,6 +415,21 @@ fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
         print_out(&format!("{}\n", serde_json::to_string(&rows)?))?;
     } else {
         print_out(&format_pile_table(&rows))?;
+    }
+    Ok(())
+}
+
+fn run_mixed_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {
+    let mut rows = Vec::new();
+    for small in args.sizes.clone().unwrap_or(vec![5_000]) {
+        for mode in [CollisionMode::Continuous, CollisionMode::Discrete] {
+            rows.push(run_mixed(small as usize, mode, args.steps.unwrap_or(200))?);
+        }
+    }
+    if args.json {
+        print_out(&format!("{}\n", serde_json::to_string(&rows)?))?;
+    } else {
+        print_out(&format_mixed_table(&rows))?;
     }
     Ok(())
 }

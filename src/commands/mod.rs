@@ -5,6 +5,7 @@
 //! build on [`headless`](crate::headless) apps and never touch the toy.
 
 pub mod bench;
+pub mod mixed;
 pub mod observe;
 pub mod pile;
 pub mod progress;
