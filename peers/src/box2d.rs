@@ -3,6 +3,7 @@
 //! set through the density. A gas: restitution threshold 0 and no sleep, so every impact is
 //! elastic; a pile: Box2D's own threshold (1 m/s) and sleep.
 
+use bevy::math::DVec2;
 use boxdd::prelude::*;
 
 use crate::Engine;
@@ -88,8 +89,8 @@ impl Engine for Box2d {
                     body.linear_velocity().expect("velocity"),
                 );
                 Ball {
-                    position: bevy::math::DVec2::new(pixels(p.x), pixels(p.y)),
-                    velocity: bevy::math::DVec2::new(pixels(v.x), pixels(v.y)),
+                    position: DVec2::new(pixels(p.x), pixels(p.y)),
+                    velocity: DVec2::new(pixels(v.x), pixels(v.y)),
                     radius,
                 }
             })

@@ -44,6 +44,24 @@ pub fn find_contacts(
     }
 }
 
+/// Appends to `found` every touching pair among `circles` as `(a, b)`, `a < b`: the pairs
+/// [`find_contacts`] finds with the grid, in its order, without their geometry (for callers
+/// that measure the pairs themselves).
+pub fn find_touching_pairs(
+    circles: &[Circle],
+    grid: &mut UniformGrid,
+    found: &mut Vec<(u32, u32)>,
+) {
+    grid.rebuild(circles);
+    search_in_bands(grid, found, |grid, rows, local| {
+        grid.for_each_candidate_pair_in_rows(rows, |i, j, ci, cj| {
+            if circles_touch(ci, cj) {
+                local.push((i.min(j), i.max(j)));
+            }
+        });
+    });
+}
+
 /// Runs `search(grid, rows, out)` over bands of the grid's rows and appends what the bands
 /// find to `found` in row order, so the result does not depend on the thread count. The bands
 /// run in parallel on the compute pool once the grid holds `PARALLEL_MIN_BALLS` (20,000) balls.

@@ -9,9 +9,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::constraint::{Body, Other, RestingContact};
-use crate::sim::geometry::circle::{Circle, circles_touch, contact_normal};
+use crate::sim::geometry::circle::{Circle, contact_normal};
 use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::search_in_bands;
+use crate::sim::geometry::pairs::find_touching_pairs;
 use crate::sim::geometry::wall::Wall;
 use crate::sim::params::MassModel;
 
@@ -91,14 +91,7 @@ impl NearPairs {
                 .map(|(c, v)| Circle::new(c.center, c.radius + reach(c, v))),
         );
         self.found.clear();
-        self.grid.rebuild(&self.inflated);
-        search_in_bands(&self.grid, &mut self.found, |grid, rows, found| {
-            grid.for_each_candidate_pair_in_rows(rows, |i, j, ci, cj| {
-                if circles_touch(ci, cj) {
-                    found.push((i.min(j), i.max(j)));
-                }
-            });
-        });
+        find_touching_pairs(&self.inflated, &mut self.grid, &mut self.found);
         self.touching.clear();
         self.touching.resize(circles.len(), false);
         self.near.clear();

@@ -11,19 +11,7 @@
 use bevy::math::DVec2;
 
 use super::constraint::{Body, Other, RestingContact};
-
-/// The mechanical energy of `bodies` (kinetic plus potential under `gravity`), the movable
-/// ones only, at positions `position + shift` and the velocity each has in `velocity_of`.
-fn mechanical_energy(bodies: &[Body], velocity_of: impl Fn(usize) -> DVec2, gravity: DVec2) -> f64 {
-    (bodies.iter().enumerate())
-        .filter(|(_, body)| body.inverse_mass > 0.0)
-        .map(|(index, body)| {
-            let mass = 1.0 / body.inverse_mass;
-            0.5 * mass * velocity_of(index).length_squared()
-                - mass * gravity.dot(body.position + body.shift)
-        })
-        .sum()
-}
+use crate::sim::measure::summary::{kinetic_energy, potential_energy};
 
 /// What pushing out the overlaps the `contacts` began the step with may add to the bodies'
 /// mechanical energy: each overlap's spring energy (stiffness `omega`, radians per second,
@@ -68,12 +56,17 @@ pub fn keep_energy(
     gravity: DVec2,
     hertz: f64,
 ) -> f64 {
-    let unmoved: Vec<Body> = bodies
-        .iter()
-        .map(|body| Body::new(body.position, DVec2::ZERO, body.inverse_mass))
-        .collect();
-    let before = mechanical_energy(&unmoved, |index| start[index], gravity);
-    let after = mechanical_energy(bodies, |index| bodies[index].velocity, gravity);
+    let mechanical = |mass: f64, velocity: DVec2, position: DVec2| {
+        kinetic_energy(mass, velocity) + potential_energy(mass, position, gravity)
+    };
+    let (mut before, mut after) = (0.0, 0.0);
+    for (body, &velocity) in bodies.iter().zip(start) {
+        if body.inverse_mass > 0.0 {
+            let mass = 1.0 / body.inverse_mass;
+            before += mechanical(mass, velocity, body.position);
+            after += mechanical(mass, body.velocity, body.position + body.shift);
+        }
+    }
     let omega = 2.0 * std::f64::consts::PI * hertz;
     let excess = after - before - overlap_allowance(bodies, contacts, gravity, omega);
     if excess <= 0.0 {

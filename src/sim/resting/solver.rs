@@ -93,8 +93,8 @@ const NO_SLOT: u32 = u32::MAX;
 /// The solver's working arrays. Each body a contact touches, and each movable one, has a
 /// slot, numbered in the order the contacts first name them (neighbours in space stay
 /// neighbours in memory), with its motion and inverse mass; one last slot, an anchor that
-/// never moves, stands for the walls. Each contact is a [`Link`]. The passes are plain loops
-/// over them.
+/// never moves, stands for the walls. Each contact is a [`Link`]. The substeps' passes run
+/// on a `WideStep` filled from them; the restitution pass is a plain loop over them.
 #[derive(Debug, Default)]
 struct Work {
     motion: Vec<Motion>,
