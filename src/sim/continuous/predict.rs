@@ -36,22 +36,28 @@ impl Timeline {
         spec: StepSpec,
     ) {
         let dt = spec.dt;
-        self.movers.clear();
-        self.movers
-            .extend(circles.iter().zip(velocities).zip(held).map(
-                |((circle, velocity), &still)| Mover::new(*circle, *velocity, spec.gravity, still),
-            ));
         self.swept.clear();
         self.swept
-            .extend(self.movers.iter().map(|mover| swept_by(mover, dt)));
+            .extend(circles.iter().zip(velocities).zip(held).map(
+                |((circle, velocity), &still)| {
+                    swept_by(&Mover::new(*circle, *velocity, spec.gravity, still), dt)
+                },
+            ));
         self.grid_reach = self.swept.iter().map(|s| s.radius).fold(0.0, f64::max);
         self.grid.rebuild(&self.swept);
+        // From here on every ball is known by its slot in the grid's cell order.
+        self.grid.renumber_by_slot(&mut self.order);
+        self.movers.clear();
+        self.movers.extend(self.order.iter().map(|&ball| {
+            let ball = ball as usize;
+            Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball])
+        }));
         self.predictions.clear();
         let flying = self.movers.iter().filter(|mover| !mover.still).count();
         if flying * FEW_FLYING < self.movers.len() {
-            self.predict_around_the_flying(circles, dt);
+            self.predict_around_the_flying(dt);
         } else {
-            self.predict_every_pair(circles, dt);
+            self.predict_every_pair(dt);
         }
         for (index, mover) in self.movers.iter().enumerate() {
             if let Some((time, wall)) = wall_time(mover, spec)
@@ -65,7 +71,7 @@ impl Timeline {
 
     /// Every pair's impact, through the grid's candidate pairs, in parallel bands for many
     /// balls.
-    fn predict_every_pair(&mut self, circles: &[Circle], dt: f64) {
+    fn predict_every_pair(&mut self, dt: f64) {
         let movers = &self.movers;
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
             grid.for_each_candidate_pair_in_rows(rows, |i, j, swept_i, swept_j| {
@@ -74,7 +80,7 @@ impl Timeline {
                     return;
                 }
                 let (a, b) = (i.min(j), i.max(j));
-                predict_pair(circles, movers, (a, b), dt, found);
+                predict_pair(movers, (a, b), dt, found);
             });
         });
     }
@@ -83,10 +89,10 @@ impl Timeline {
     /// never meet, so only the flying balls' neighbourhoods are searched, each pair once. It
     /// finds what [`predict_every_pair`](Self::predict_every_pair) finds (tested), but the
     /// overlaps of two still balls, which the timeline leaves to the resting stage.
-    fn predict_around_the_flying(&mut self, circles: &[Circle], dt: f64) {
-        let (movers, swept, found) = (&self.movers, &self.swept, &mut self.predictions);
+    fn predict_around_the_flying(&mut self, dt: f64) {
+        let (movers, found) = (&self.movers, &mut self.predictions);
         for (index, _) in movers.iter().enumerate().filter(|(_, m)| !m.still) {
-            let own = swept[index];
+            let own = self.grid.circle_in_slot(index);
             let near = DVec2::splat(own.radius + self.grid_reach);
             self.grid.for_each_near(
                 own.center - near,
@@ -101,7 +107,7 @@ impl Timeline {
                         return;
                     }
                     let pair = ((index as u32).min(other), (index as u32).max(other));
-                    predict_pair(circles, movers, pair, dt, found);
+                    predict_pair(movers, pair, dt, found);
                 },
             );
         }
@@ -159,7 +165,9 @@ impl Timeline {
             swept.center - near,
             swept.center + near,
             |other, other_swept| {
-                if movers[other as usize].hits == 0 && circles_touch(swept, other_swept) {
+                // The swept circle first: it sits in the grid's contiguous cells, while the
+                // hit count is a read from anywhere in `movers`.
+                if circles_touch(swept, other_swept) && movers[other as usize].hits == 0 {
                     consider(other);
                 }
             },
@@ -169,11 +177,8 @@ impl Timeline {
         self.grid
             .for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
                 let hits_of = |ball: u32| movers[ball as usize].hits;
-                rerouted.for_each_in_cells(cells, hits_of, |other, other_swept| {
-                    if circles_touch(swept, other_swept) {
-                        consider(other);
-                    }
-                });
+                let touches = |other_swept| circles_touch(swept, other_swept);
+                rerouted.for_each_in_cells(cells, touches, hits_of, |other, _| consider(other));
             });
     }
 }
@@ -232,17 +237,12 @@ const FEW_FLYING: usize = 4;
 
 /// What the search finds for the pair `(a, b)`, `a < b`: an overlap at the start, an impact
 /// within the step.
-fn predict_pair(
-    circles: &[Circle],
-    movers: &[Mover],
-    (a, b): (u32, u32),
-    dt: f64,
-    found: &mut Vec<Prediction>,
-) {
-    if overlapping(circles[a as usize], circles[b as usize]) {
+fn predict_pair(movers: &[Mover], (a, b): (u32, u32), dt: f64, found: &mut Vec<Prediction>) {
+    let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
+    if overlapping(mover_a.circle(), mover_b.circle()) {
         found.push(Prediction::Overlap(a, b));
     }
-    if let Some(time) = pair_time(&movers[a as usize], &movers[b as usize], 0.0, dt) {
+    if let Some(time) = pair_time(mover_a, mover_b, 0.0, dt) {
         let impact = Impact::between(time, (a as usize, 0), (b as usize, 0));
         found.push(Prediction::Impact(impact));
     }
@@ -295,14 +295,15 @@ mod tests {
         let mut timeline = Timeline::default();
         timeline.predict(&circles, &velocities, &held, spec);
         timeline.predictions.clear();
-        timeline.predict_around_the_flying(&circles, spec.dt);
+        timeline.predict_around_the_flying(spec.dt);
         let around = sorted(&timeline.predictions);
         timeline.predictions.clear();
-        timeline.predict_every_pair(&circles, spec.dt);
+        timeline.predict_every_pair(spec.dt);
         // Overlaps of two still balls are the resting stage's: the timeline skips them.
-        timeline.predictions.retain(
-            |p| !matches!(*p, Prediction::Overlap(a, b) if held[a as usize] && held[b as usize]),
-        );
+        let still = |slot: u32| timeline.movers[slot as usize].still;
+        timeline
+            .predictions
+            .retain(|p| !matches!(*p, Prediction::Overlap(a, b) if still(a) && still(b)));
         let every = sorted(&timeline.predictions);
         assert!(around.len() > 20, "{} predictions", around.len());
         assert_eq!(around, every);

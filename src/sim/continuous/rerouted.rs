@@ -53,11 +53,13 @@ impl Rerouted {
         self.reach = self.reach.max(swept.radius);
     }
 
-    /// Calls `visit(ball, swept)` for the balls whose entry in `cells` is still current:
-    /// `hits_of(ball)` is the hit count it was filed with.
+    /// Calls `visit(ball, swept)` for the balls whose entry in `cells` passes `filter` and is
+    /// still current: `hits_of(ball)` is the hit count it was filed with. `filter` comes
+    /// first, as it reads only the entry.
     pub fn for_each_in_cells(
         &self,
         cells: std::ops::Range<usize>,
+        filter: impl Fn(Circle) -> bool,
         hits_of: impl Fn(u32) -> u32,
         mut visit: impl FnMut(u32, Circle),
     ) {
@@ -70,7 +72,7 @@ impl Rerouted {
                     next,
                     swept,
                 } = self.entries[entry as usize];
-                if hits_of(ball) == hits {
+                if filter(swept) && hits_of(ball) == hits {
                     visit(ball, swept);
                 }
                 entry = next;

@@ -136,15 +136,20 @@ impl Mover {
 /// The continuous mode's working state, kept between steps to reuse its buffers.
 #[derive(Resource, Debug, Default)]
 pub struct Timeline {
-    /// Each ball's circle swept over the whole step, sorted into cells.
+    /// Each ball's circle swept over the whole step, sorted into cells. The timeline knows
+    /// every ball by its slot in this cell order, so the balls an impact's neighbourhood
+    /// reads lie close together in memory.
     pub(super) grid: UniformGrid,
+    /// The ball in each slot: `order[slot]` is its index in the arrays the step was given.
+    pub(super) order: Vec<u32>,
+    /// Each ball's swept circle by index, to sort into the grid.
     pub(super) swept: Vec<Circle>,
     /// Largest radius in `swept`.
     pub(super) grid_reach: f64,
     pub(super) predictions: Vec<Prediction>,
     pub(super) queue: BinaryHeap<Reverse<Impact>>,
     pub(super) overlapping: Vec<(u32, u32)>,
-    /// Every ball on this step's timeline, by index: all a prediction reads of one ball in
+    /// Every ball on this step's timeline, by slot: all a prediction reads of one ball in
     /// one cache line.
     pub(super) movers: Vec<Mover>,
     pub(super) rerouted: Rerouted,

@@ -68,7 +68,10 @@ impl Timeline {
         for prediction in &self.predictions {
             match *prediction {
                 Prediction::Impact(impact) => self.queue.push(Reverse(impact)),
-                Prediction::Overlap(a, b) => self.overlapping.push((a, b)),
+                Prediction::Overlap(a, b) => {
+                    let (a, b) = (self.order[a as usize], self.order[b as usize]);
+                    self.overlapping.push((a.min(b), a.max(b)));
+                }
             }
         }
         self.cut_short = false;
@@ -128,7 +131,7 @@ impl Timeline {
         mover.accel = spec.gravity;
         mover.hits += 1;
         on_hit(Hit::Wall {
-            ball: impact.a,
+            ball: self.order[a],
             wall,
             time: now,
             point: bounce.point,
@@ -142,7 +145,11 @@ impl Timeline {
     /// centres if they still approach, or come to rest on each other if slower than the
     /// resting speed.
     fn collide(&mut self, impact: Impact, spec: StepSpec, on_hit: &mut impl FnMut(Hit)) {
-        let (a, b, now) = (impact.a as usize, impact.other as usize, impact.time);
+        // The pair in the order of the balls' indices, whatever their slots.
+        let (mut a, mut b, now) = (impact.a as usize, impact.other as usize, impact.time);
+        if self.order[a] > self.order[b] {
+            (a, b) = (b, a);
+        }
         self.movers[a].advance(now);
         self.movers[b].advance(now);
         let (ma, mb) = (self.movers[a], self.movers[b]);
@@ -172,8 +179,8 @@ impl Timeline {
         self.movers[a].hits += 1;
         self.movers[b].hits += 1;
         on_hit(Hit::Ball {
-            a: impact.a,
-            b: impact.other,
+            a: self.order[a],
+            b: self.order[b],
             time: now,
             point: collision_point(ma.circle(), mb.circle()),
             normal,
@@ -247,7 +254,8 @@ impl Timeline {
         (held, stopped): (&mut [bool], &mut [bool]),
         spec: StepSpec,
     ) {
-        for (index, mover) in self.movers.iter_mut().enumerate() {
+        for (&ball, mover) in self.order.iter().zip(&mut self.movers) {
+            let index = ball as usize;
             mover.advance(spec.dt);
             (circles[index].center, velocities[index]) = (mover.center, mover.velocity);
             held[index] &= mover.still && mover.hits == 0;

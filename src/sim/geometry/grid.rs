@@ -91,6 +91,21 @@ impl UniformGrid {
         );
     }
 
+    /// Hands over the balls' order in the cells (`order[slot]` is the index the ball had in
+    /// the slice given to [`rebuild`](Self::rebuild)) and from now on numbers each ball by its
+    /// slot: for a caller that keeps its own per-ball data in cell order, so that balls near
+    /// each other in space are near each other in memory.
+    pub fn renumber_by_slot(&mut self, order: &mut Vec<u32>) {
+        std::mem::swap(order, &mut self.sorted_index);
+        self.sorted_index.clear();
+        self.sorted_index.extend(0..order.len() as u32);
+    }
+
+    /// The circle of the ball in `slot` of the cell order.
+    pub fn circle_in_slot(&self, slot: usize) -> Circle {
+        self.sorted_circle[slot]
+    }
+
     /// Number of balls sorted in.
     pub fn len(&self) -> usize {
         self.sorted_index.len()
