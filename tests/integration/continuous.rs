@@ -313,3 +313,41 @@ fn the_elastic_gas_under_gravity_keeps_its_mechanical_energy() {
     );
     assert_eq!(app.world().resource::<SimStats>().cut_short_steps, 0);
 }
+
+#[test]
+fn a_few_big_balls_among_many_small_ones_never_overlap_and_keep_the_energy() {
+    // The mixed scene with 2,000 small balls: its three big ones stay out of the grid's
+    // cells, in a grid of their own, so this checks that every impact with them is found,
+    // first paths and redirected ones alike.
+    let mut scene = shipped_scene("mixed.ron");
+    scene.generate.as_mut().unwrap().count = 2000;
+    let setup = scene.build("mixed.ron").unwrap();
+    let mut app = app_in(CollisionMode::Continuous, setup.params, &setup.balls);
+    let big_velocities = |app: &mut App| -> Vec<DVec2> {
+        let balls = states(app);
+        balls
+            .iter()
+            .filter(|b| b.radius >= 40.0)
+            .map(|b| b.velocity)
+            .collect()
+    };
+    let start = StateSummary::measure(app.world_mut());
+    let big_before = big_velocities(&mut app);
+    step(&mut app, 120);
+    let end = StateSummary::measure(app.world_mut());
+    let change = (end.kinetic_energy - start.kinetic_energy) / start.kinetic_energy;
+    assert!(change.abs() < 1e-9, "relative change {change}");
+    assert!(
+        end.max_overlap_rel < 1e-9,
+        "overlap {}",
+        end.max_overlap_rel
+    );
+    let big_after = big_velocities(&mut app);
+    assert_eq!(big_after.len(), 3);
+    for (before, after) in big_before.iter().zip(&big_after) {
+        assert!(
+            before.distance(*after) > 1.0,
+            "a big ball never hit: {before} {after}"
+        );
+    }
+}

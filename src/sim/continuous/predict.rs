@@ -43,7 +43,6 @@ impl Timeline {
                     swept_by(&Mover::new(*circle, *velocity, spec.gravity, still), dt)
                 },
             ));
-        self.grid_reach = self.swept.iter().map(|s| s.radius).fold(0.0, f64::max);
         self.grid.rebuild(&self.swept);
         // From here on every ball is known by its slot in the grid's cell order.
         self.grid.renumber_by_slot(&mut self.order);
@@ -93,11 +92,8 @@ impl Timeline {
         let (movers, found) = (&self.movers, &mut self.predictions);
         for (index, _) in movers.iter().enumerate().filter(|(_, m)| !m.still) {
             let own = self.grid.circle_in_slot(index);
-            let near = DVec2::splat(own.radius + self.grid_reach);
-            self.grid.for_each_near(
-                own.center - near,
-                own.center + near,
-                |other, other_swept| {
+            self.grid
+                .for_each_that_may_touch(own, |other, other_swept| {
                     let other_flies = !movers[other as usize].still;
                     // A pair of flying balls is taken from its lower index.
                     if other as usize == index
@@ -108,8 +104,7 @@ impl Timeline {
                     }
                     let pair = ((index as u32).min(other), (index as u32).max(other));
                     predict_pair(movers, pair, dt, found);
-                },
-            );
+                });
         }
     }
 
@@ -135,12 +130,8 @@ impl Timeline {
         let rest = spec.dt - now;
         let mut swept = swept_by(&mover, rest);
         swept.radius += SWEPT_MARGIN;
-        self.rerouted.insert(
-            self.grid.cell_index(swept.center),
-            index as u32,
-            mover.hits,
-            swept,
-        );
+        self.rerouted
+            .insert(&self.grid, index as u32, mover.hits, swept);
         let movers = &self.movers;
         let mut consider = |other: u32| {
             let other_index = other as usize;
@@ -160,26 +151,17 @@ impl Timeline {
         // Balls on their first path of the step are filed in the grid by the circle that path
         // sweeps; the ones that changed course since, in `rerouted`. Both filters are the
         // swept circles: if they do not touch, neither can the balls.
-        let near = DVec2::splat(swept.radius + self.grid_reach);
-        self.grid.for_each_near(
-            swept.center - near,
-            swept.center + near,
-            |other, other_swept| {
-                // The swept circle first: it sits in the grid's contiguous cells, while the
-                // hit count is a read from anywhere in `movers`.
+        self.grid
+            .for_each_that_may_touch(swept, |other, other_swept| {
+                // The swept circle first: it sits in the grid's contiguous cells, while the hit
+                // count is a read from anywhere in `movers`.
                 if circles_touch(swept, other_swept) && movers[other as usize].hits == 0 {
                     consider(other);
                 }
-            },
-        );
-        let near = DVec2::splat(swept.radius + self.rerouted.reach);
-        let rerouted = &self.rerouted;
-        self.grid
-            .for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
-                let hits_of = |ball: u32| movers[ball as usize].hits;
-                let touches = |other_swept| circles_touch(swept, other_swept);
-                rerouted.for_each_in_cells(cells, touches, hits_of, |other, _| consider(other));
             });
+        let hits_of = |ball: u32| movers[ball as usize].hits;
+        self.rerouted
+            .for_each_that_may_touch(&self.grid, swept, hits_of, consider);
     }
 }
 

@@ -144,8 +144,6 @@ pub struct Timeline {
     pub(super) order: Vec<u32>,
     /// Each ball's swept circle by index, to sort into the grid.
     pub(super) swept: Vec<Circle>,
-    /// Largest radius in `swept`.
-    pub(super) grid_reach: f64,
     pub(super) predictions: Vec<Prediction>,
     pub(super) queue: BinaryHeap<Reverse<Impact>>,
     pub(super) overlapping: Vec<(u32, u32)>,

@@ -1,0 +1,77 @@
+//! The grid's cells as geometry: where they start, how big they are, and which cell holds a
+//! point. [`CellMap`] is a plain value, so the grid's passes copy it and borrow nothing.
+
+use bevy::math::DVec2;
+
+/// The grid never has more cells than this many per ball, so a few tiny balls in a huge
+/// arena cost little memory; the cells grow instead.
+const MAX_CELLS_PER_BALL: usize = 4;
+
+/// Square cells in rows and columns over a rectangle, numbered row-major from `origin`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CellMap {
+    origin: DVec2,
+    inverse_cell_size: f64,
+    pub columns: usize,
+    pub rows: usize,
+}
+
+impl CellMap {
+    /// The smallest cells over `[min, max]` that hold a circle of radius `largest_radius`
+    /// (so two touching circles sit in the same or adjacent cells), at most
+    /// `MAX_CELLS_PER_BALL` (4) cells for each of `balls`.
+    pub fn covering(min: DVec2, max: DVec2, largest_radius: f64, balls: usize) -> Self {
+        let extent = max - min;
+        let max_cells = (balls * MAX_CELLS_PER_BALL).max(1);
+        let cell_size = (2.0 * largest_radius)
+            .max((extent.x * extent.y / max_cells as f64).sqrt())
+            .max(f64::MIN_POSITIVE);
+        // The caps only bind for non-finite extents; clamping cells together never separates
+        // two touching balls by more than one cell, so no pair is lost.
+        let columns = cells_along(extent.x, cell_size).min(max_cells);
+        let rows = cells_along(extent.y, cell_size).min((max_cells / columns).max(1));
+        Self {
+            origin: min,
+            inverse_cell_size: 1.0 / cell_size,
+            columns,
+            rows,
+        }
+    }
+
+    pub fn cell_count(&self) -> usize {
+        self.columns * self.rows
+    }
+
+    /// The cell holding `point`. A point outside the grid goes to the nearest border cell, so
+    /// the cell order along each axis never contradicts the points' order.
+    pub fn cell_index(&self, point: DVec2) -> usize {
+        let (column, row) = self.cell_coordinates(point);
+        row * self.columns + column
+    }
+
+    /// `(column, row)` of the cell holding `point`, clamped to the grid as
+    /// [`cell_index`](Self::cell_index) is.
+    pub fn cell_coordinates(&self, point: DVec2) -> (usize, usize) {
+        // `as usize` saturates (and maps NaN to 0), so a stray value cannot index out of range.
+        let cell = (point - self.origin) * self.inverse_cell_size;
+        let column = (cell.x as usize).min(self.columns - 1);
+        let row = (cell.y as usize).min(self.rows - 1);
+        (column, row)
+    }
+}
+
+fn cells_along(extent: f64, cell_size: f64) -> usize {
+    // Saturating casts: a non-finite extent collapses to one cell rather than panicking.
+    ((extent / cell_size) as usize).saturating_add(1).max(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cell_count_stays_bounded_for_tiny_balls_far_apart() {
+        let map = CellMap::covering(DVec2::splat(-1.0e6), DVec2::splat(1.0e6), 0.5, 2);
+        assert!(map.cell_count() <= 2 * MAX_CELLS_PER_BALL + 4);
+    }
+}

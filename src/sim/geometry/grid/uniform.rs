@@ -1,0 +1,384 @@
+//! [`UniformGrid`]: the balls sorted into square cells by a counting sort, rebuilt from
+//! scratch every step, so that candidate pairs and the balls near a point are found in O(N).
+//!
+//! The cells are sized by the largest of the ordinary balls. A ball whose radius is more than
+//! `BIG_RADIUS_FACTOR` (4) times the mean is big: it stays out of the cells and goes into a
+//! grid of its own (and so on down, a hierarchy), so a few big balls among many small ones do
+//! not make every cell big. Each big ball is paired with the small balls in the cells its
+//! circle reaches, row by row ([`RowLists`]).
+
+use bevy::math::DVec2;
+
+use super::cells::CellMap;
+use super::rows::RowLists;
+use crate::sim::geometry::circle::Circle;
+
+/// A ball whose radius is more than this many times the mean radius is big: see the header.
+const BIG_RADIUS_FACTOR: f64 = 4.0;
+
+/// A uniform grid over the balls' centres, rebuilt from scratch every step by a counting sort.
+///
+/// The cell side is at least the largest diameter of the balls in the cells, so two touching
+/// circles always sit in the same or in adjacent cells. The buffers are kept between steps.
+#[derive(Debug, Default)]
+pub struct UniformGrid {
+    pub(super) cells: CellMap,
+    /// `cell_start[c]..cell_start[c + 1]` is cell `c`'s range of slots.
+    pub(super) cell_start: Vec<u32>,
+    /// The ball in each slot, by its index: the balls in the cells in cell order, then the
+    /// big ones in input order.
+    pub(super) sorted_index: Vec<u32>,
+    /// The circles in slot order, so the pair loops read contiguous memory.
+    pub(super) sorted_circle: Vec<Circle>,
+    cell_of: Vec<u32>,
+    /// Slots `0..small_count` are in the cells; the rest are the big balls.
+    pub(super) small_count: usize,
+    /// Largest radius of a ball in the cells.
+    pub(super) small_reach: f64,
+    /// A radius above this is big.
+    big_limit: f64,
+    /// The big balls' own grid, numbering them by their order among the big ones; in use
+    /// while there are big balls.
+    big: Option<Box<UniformGrid>>,
+    /// For each row of cells, the big balls (by that order) whose circle, grown by
+    /// `small_reach`, reaches into it.
+    big_rows: RowLists,
+}
+
+/// Marks a big ball in `cell_of`.
+const NO_CELL: u32 = u32::MAX;
+
+/// Whether a ball of `radius` is big where the limit is `big_limit`. A NaN is not big.
+fn is_big(radius: f64, big_limit: f64) -> bool {
+    radius > big_limit
+}
+
+impl UniformGrid {
+    /// Sorts `circles` into cells, the big ones apart.
+    pub fn rebuild(&mut self, circles: &[Circle]) {
+        let radius_sum: f64 = circles.iter().map(|circle| circle.radius).sum();
+        self.big_limit = BIG_RADIUS_FACTOR * radius_sum / circles.len().max(1) as f64;
+        let big_limit = self.big_limit;
+        let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
+        for circle in circles {
+            min = min.min(circle.center);
+            max = max.max(circle.center);
+            if !is_big(circle.radius, big_limit) {
+                largest_radius = largest_radius.max(circle.radius);
+            }
+        }
+        if circles.is_empty() {
+            (min, max) = (DVec2::ZERO, DVec2::ZERO);
+        }
+        self.small_reach = largest_radius;
+        self.cells = CellMap::covering(min, max, largest_radius, circles.len());
+        let cell_count = self.cells.cell_count();
+        self.cell_start.clear();
+        self.cell_start.resize(cell_count + 1, 0);
+        self.cell_of.clear();
+        for circle in circles {
+            if is_big(circle.radius, big_limit) {
+                self.cell_of.push(NO_CELL);
+                continue;
+            }
+            let cell = self.cells.cell_index(circle.center);
+            self.cell_of.push(cell as u32);
+            self.cell_start[cell] += 1;
+        }
+        // Inclusive prefix sums: each entry becomes its cell's end. Scattering the balls in
+        // reverse then counts each entry down to its cell's start, keeping the balls of a cell
+        // in their input order, with no second copy of the table.
+        let mut running = 0;
+        for count in &mut self.cell_start[..cell_count] {
+            running += *count;
+            *count = running;
+        }
+        self.small_count = running as usize;
+        self.cell_start[cell_count] = running;
+        self.sorted_index.resize(circles.len(), 0);
+        let mut big_slot = self.small_count;
+        for (index, &cell) in self.cell_of.iter().enumerate().rev() {
+            if cell == NO_CELL {
+                big_slot += 1;
+                continue;
+            }
+            let slot = &mut self.cell_start[cell as usize];
+            *slot -= 1;
+            self.sorted_index[*slot as usize] = index as u32;
+        }
+        if big_slot > self.small_count {
+            let big_balls = self
+                .cell_of
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| **c == NO_CELL);
+            for (slot, (index, _)) in (self.small_count..).zip(big_balls) {
+                self.sorted_index[slot] = index as u32;
+            }
+        }
+        // Scatter only the indices, then gather the circles: independent random reads overlap
+        // in the memory system far better than random writes of whole circles.
+        self.sorted_circle.clear();
+        self.sorted_circle.extend(
+            self.sorted_index
+                .iter()
+                .map(|&index| circles[index as usize]),
+        );
+        self.rebuild_big();
+    }
+
+    /// The big balls' grid and the rows each reaches.
+    fn rebuild_big(&mut self) {
+        let big_circles = &self.sorted_circle[self.small_count..];
+        if big_circles.is_empty() {
+            return;
+        }
+        let big = self.big.get_or_insert_with(Box::default);
+        big.rebuild(big_circles);
+        let (cells, reach) = (self.cells, self.small_reach);
+        let spans = big_circles.iter().map(|circle| {
+            let near = DVec2::splat(circle.radius + reach);
+            let (_, first) = cells.cell_coordinates(circle.center - near);
+            let (_, last) = cells.cell_coordinates(circle.center + near);
+            first..=last
+        });
+        self.big_rows.rebuild(cells.rows, spans);
+    }
+
+    /// The big balls' grid, if there are big balls.
+    pub(super) fn big_grid(&self) -> Option<&UniformGrid> {
+        self.big
+            .as_deref()
+            .filter(|_| self.small_count < self.len())
+    }
+
+    /// Hands over the balls' order in the grid (`order[slot]` is the index the ball had in
+    /// the slice given to [`rebuild`](Self::rebuild)) and from now on numbers each ball by its
+    /// slot: for a caller that keeps its own per-ball data in this order, so that balls near
+    /// each other in space are near each other in memory.
+    pub fn renumber_by_slot(&mut self, order: &mut Vec<u32>) {
+        std::mem::swap(order, &mut self.sorted_index);
+        self.sorted_index.clear();
+        self.sorted_index.extend(0..order.len() as u32);
+    }
+
+    /// The circle of the ball in `slot`.
+    pub fn circle_in_slot(&self, slot: usize) -> Circle {
+        self.sorted_circle[slot]
+    }
+
+    /// Number of balls sorted in.
+    pub fn len(&self) -> usize {
+        self.sorted_index.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.sorted_index.is_empty()
+    }
+
+    /// Rows of cells: the unit [`for_each_candidate_pair_in_rows`](Self::for_each_candidate_pair_in_rows)
+    /// splits work by.
+    pub fn rows(&self) -> usize {
+        self.cells.rows
+    }
+
+    /// A radius above this is big (see the header): a caller filing its own circles by this
+    /// grid's cells keeps those apart too.
+    pub fn big_limit(&self) -> f64 {
+        self.big_limit
+    }
+
+    /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls in the same or
+    /// adjacent cells, and every pair with a big ball whose circles' boxes might meet, in a
+    /// fixed order (the big balls' own pairs first, then row by row). Indices are the
+    /// positions in the slice given to [`rebuild`](Self::rebuild).
+    pub fn for_each_candidate_pair(&self, visit: impl FnMut(u32, u32, Circle, Circle)) {
+        self.for_each_candidate_pair_in_rows(0..self.rows(), visit);
+    }
+
+    /// The pairs [`for_each_candidate_pair`](Self::for_each_candidate_pair) visits from the
+    /// cells of `rows`, in the same order (the big balls' own pairs with the first row).
+    /// Disjoint row ranges visit disjoint pairs, so bands of rows can be searched in parallel
+    /// and their results joined in row order.
+    pub fn for_each_candidate_pair_in_rows(
+        &self,
+        rows: std::ops::Range<usize>,
+        mut visit: impl FnMut(u32, u32, Circle, Circle),
+    ) {
+        if rows.start == 0 {
+            self.visit_big_pairs(&mut visit);
+        }
+        // In row-major order a cell and its right neighbour are adjacent, and the three cells
+        // above (left, centre, right) are one contiguous run: each ball's candidates are two
+        // contiguous slot ranges, the rest of its own cell with the right cell, and the run above.
+        let columns = self.cells.columns;
+        for row in rows {
+            for column in 0..columns {
+                let cell = row * columns + column;
+                let (start, end) = (
+                    self.cell_start[cell] as usize,
+                    self.cell_start[cell + 1] as usize,
+                );
+                if start == end {
+                    continue;
+                }
+                let same_row_end =
+                    self.cell_start[cell + usize::from(column + 1 < columns) + 1] as usize;
+                let above = if row + 1 < self.cells.rows {
+                    let first = cell + columns - usize::from(column > 0);
+                    let last = cell + columns + usize::from(column + 1 < columns);
+                    self.cell_start[first] as usize..self.cell_start[last + 1] as usize
+                } else {
+                    0..0
+                };
+                for slot in start..end {
+                    let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
+                    // Two plain loops over slices: no bounds checks and no chained iterator.
+                    for range in [slot + 1..same_row_end, above.clone()] {
+                        let others = self.sorted_index[range.clone()]
+                            .iter()
+                            .zip(&self.sorted_circle[range]);
+                        for (&other_index, &other) in others {
+                            visit(index, other_index, circle, other);
+                        }
+                    }
+                }
+            }
+            if self.big_grid().is_some() {
+                self.visit_big_with_small_in_row(row, &mut visit);
+            }
+        }
+    }
+
+    /// The pairs of two big balls, through their own grid.
+    fn visit_big_pairs(&self, visit: &mut dyn FnMut(u32, u32, Circle, Circle)) {
+        if let Some(big) = self.big_grid() {
+            let index = |k: u32| self.sorted_index[self.small_count + k as usize];
+            big.for_each_candidate_pair(|i, j, a, b| visit(index(i), index(j), a, b));
+        }
+    }
+
+    /// Each big ball that reaches `row` with every ball in the cells of `row` it reaches.
+    fn visit_big_with_small_in_row(
+        &self,
+        row: usize,
+        visit: &mut impl FnMut(u32, u32, Circle, Circle),
+    ) {
+        for &k in self.big_rows.in_row(row) {
+            let slot = self.small_count + k as usize;
+            let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
+            let near = DVec2::splat(circle.radius + self.small_reach);
+            let (first, _) = self.cells.cell_coordinates(circle.center - near);
+            let (last, _) = self.cells.cell_coordinates(circle.center + near);
+            let start = row * self.cells.columns;
+            for other in self.slots_of(start + first..start + last + 1) {
+                visit(
+                    index,
+                    self.sorted_index[other],
+                    circle,
+                    self.sorted_circle[other],
+                );
+            }
+        }
+    }
+
+    /// The slots of the balls in the consecutive cells `cells`.
+    pub(super) fn slots_of(&self, cells: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        self.cell_start[cells.start] as usize..self.cell_start[cells.end] as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::geometry::grid::{for_each_pair, mixed_sizes};
+
+    #[test]
+    fn grid_visits_each_nearby_pair_once() {
+        let circles: Vec<Circle> = (0..30)
+            .map(|i| Circle::new(DVec2::new((i % 6) as f64 * 7.0, (i / 6) as f64 * 7.0), 5.0))
+            .collect();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut seen = std::collections::HashSet::new();
+        grid.for_each_candidate_pair(|i, j, _, _| {
+            assert_ne!(i, j);
+            assert!(
+                seen.insert((i.min(j), i.max(j))),
+                "pair ({i}, {j}) visited twice"
+            );
+        });
+        // Every pair within one diameter must be among the candidates.
+        for_each_pair(&circles, |i, j, a, b| {
+            if a.center.distance(b.center) <= a.radius + b.radius {
+                assert!(seen.contains(&(i, j)), "grid missed pair ({i}, {j})");
+            }
+        });
+    }
+
+    #[test]
+    fn grid_survives_empty_single_and_non_finite_input() {
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&[]);
+        grid.for_each_candidate_pair(|_, _, _, _| panic!("no pairs in an empty grid"));
+        grid.rebuild(&[Circle::new(DVec2::ZERO, 1.0)]);
+        grid.for_each_candidate_pair(|_, _, _, _| panic!("no pairs with one ball"));
+        let strange = [
+            Circle::new(DVec2::new(f64::NAN, 0.0), 1.0),
+            Circle::new(DVec2::new(f64::INFINITY, 0.0), 1.0),
+            Circle::new(DVec2::ZERO, 1.0),
+        ];
+        grid.rebuild(&strange);
+        let mut pairs = 0;
+        grid.for_each_candidate_pair(|_, _, _, _| pairs += 1);
+        assert!(pairs <= 3);
+    }
+
+    #[test]
+    fn big_balls_apart_every_touching_pair_is_visited_once_whatever_the_bands() {
+        let circles = mixed_sizes();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        assert_eq!(grid.len() - grid.small_count, 9, "the big ones are apart");
+        let big = grid.big_grid().expect("a grid of big balls");
+        assert_eq!(
+            big.len() - big.small_count,
+            1,
+            "and the biggest apart again"
+        );
+        let mut all = Vec::new();
+        grid.for_each_candidate_pair(|i, j, a, b| {
+            assert_eq!((a, b), (circles[i as usize], circles[j as usize]));
+            all.push((i.min(j), i.max(j)));
+        });
+        let unique: std::collections::HashSet<_> = all.iter().copied().collect();
+        assert_eq!(unique.len(), all.len(), "a pair visited twice");
+        let mut touching = 0;
+        for_each_pair(&circles, |i, j, a, b| {
+            if a.center.distance(b.center) <= a.radius + b.radius {
+                touching += 1;
+                assert!(
+                    unique.contains(&(i, j)),
+                    "missed ({i}, {j}) of radii {}, {}",
+                    a.radius,
+                    b.radius
+                );
+            }
+        });
+        assert!(touching > 300, "{touching} touching pairs");
+        // Bands of rows, joined in row order, give the same pairs in the same order.
+        for bands in [2, 3, 7] {
+            let rows = grid.rows();
+            let mut joined = Vec::new();
+            for band in 0..bands {
+                grid.for_each_candidate_pair_in_rows(
+                    rows * band / bands..rows * (band + 1) / bands,
+                    |i, j, _, _| {
+                        joined.push((i.min(j), i.max(j)));
+                    },
+                );
+            }
+            assert_eq!(joined, all, "{bands} bands");
+        }
+    }
+}
