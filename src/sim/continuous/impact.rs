@@ -36,7 +36,10 @@ pub fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2)
 /// `other` values from here up name a wall, below it a ball.
 const WALL_BASE: u32 = u32::MAX - 3;
 
-/// A predicted impact: ball `a` with ball `other` (then `a < other`) or with a wall.
+/// A predicted impact: ball `a` with ball `other` or with a wall. The timeline knows its balls
+/// by slot (their place in the grid's cell order); `order` holds the same balls' indices in the
+/// step's input (`a`'s first, lower when both are balls), by which impacts at the same time
+/// are ordered, as they were before the slots.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Impact {
     /// Seconds into the step.
@@ -46,34 +49,38 @@ pub struct Impact {
     /// How many hits `a` and `other` had had when this was predicted.
     pub hits_a: u32,
     pub hits_other: u32,
+    /// The indices of `a` and `other` in the step's input (a wall's code for a wall).
+    pub order: (u32, u32),
 }
 
+/// A ball on the timeline: its slot, its index in the step's input, and its hits so far.
+pub type Party = (usize, u32, u32);
+
 impl Impact {
-    /// Ball `ball`, which has had `hits` hits, reaching `wall` at `time`.
-    pub fn with_wall(time: f64, ball: usize, hits: u32, wall: Wall) -> Self {
+    /// Ball `(slot, index, hits)` reaching `wall` at `time`.
+    pub fn with_wall(time: f64, (slot, index, hits): Party, wall: Wall) -> Self {
+        let other = WALL_BASE + wall as u32;
         Self {
             time,
-            a: ball as u32,
-            other: WALL_BASE + wall as u32,
+            a: slot as u32,
+            other,
             hits_a: hits,
             hits_other: 0,
+            order: (index, other),
         }
     }
 
-    /// Balls `i` and `j`, with `hits_i` and `hits_j` hits, meeting at `time`; stored with the
-    /// lower index first, so a pair has one key whichever ball it was found from.
-    pub fn between(time: f64, (i, hits_i): (usize, u32), (j, hits_j): (usize, u32)) -> Self {
-        let ((a, hits_a), (b, hits_other)) = if i < j {
-            ((i, hits_i), (j, hits_j))
-        } else {
-            ((j, hits_j), (i, hits_i))
-        };
+    /// Balls `i` and `j` meeting at `time`; stored with the lower index first, so a pair has
+    /// one key whichever ball it was found from.
+    pub fn between(time: f64, i: Party, j: Party) -> Self {
+        let (first, second) = if i.1 < j.1 { (i, j) } else { (j, i) };
         Self {
             time,
-            a: a as u32,
-            other: b as u32,
-            hits_a,
-            hits_other,
+            a: first.0 as u32,
+            other: second.0 as u32,
+            hits_a: first.2,
+            hits_other: second.2,
+            order: (first.1, second.1),
         }
     }
 
@@ -83,7 +90,7 @@ impl Impact {
     }
 
     fn key(&self) -> (u32, u32, u32, u32) {
-        (self.a, self.other, self.hits_a, self.hits_other)
+        (self.order.0, self.order.1, self.hits_a, self.hits_other)
     }
 }
 
@@ -130,6 +137,7 @@ mod tests {
             other,
             hits_a: 0,
             hits_other: 0,
+            order: (a, other),
         };
         let mut queue: BinaryHeap<Reverse<Impact>> = [
             impact(0.5, 3, 4),

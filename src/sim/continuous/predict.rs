@@ -58,11 +58,11 @@ impl Timeline {
         } else {
             self.predict_every_pair(dt);
         }
-        for (index, mover) in self.movers.iter().enumerate() {
+        for ((slot, mover), &index) in self.movers.iter().enumerate().zip(&self.order) {
             if let Some((time, wall)) = wall_time(mover, spec)
                 && time <= dt
             {
-                let impact = Impact::with_wall(time, index, 0, wall);
+                let impact = Impact::with_wall(time, (slot, index, 0), wall);
                 self.predictions.push(Prediction::Impact(impact));
             }
         }
@@ -71,7 +71,7 @@ impl Timeline {
     /// Every pair's impact, through the grid's candidate pairs, in parallel bands for many
     /// balls.
     fn predict_every_pair(&mut self, dt: f64) {
-        let movers = &self.movers;
+        let (movers, order) = (&self.movers, &self.order);
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
             grid.for_each_candidate_pair_in_rows(rows, |i, j, swept_i, swept_j| {
                 // The swept circles bound the paths: if they do not touch, the balls cannot.
@@ -79,7 +79,7 @@ impl Timeline {
                     return;
                 }
                 let (a, b) = (i.min(j), i.max(j));
-                predict_pair(movers, (a, b), dt, found);
+                predict_pair((movers, order), (a, b), dt, found);
             });
         });
     }
@@ -89,21 +89,32 @@ impl Timeline {
     /// finds what [`predict_every_pair`](Self::predict_every_pair) finds (tested), but the
     /// overlaps of two still balls, which the timeline leaves to the resting stage.
     fn predict_around_the_flying(&mut self, dt: f64) {
-        let (movers, found) = (&self.movers, &mut self.predictions);
-        for (index, _) in movers.iter().enumerate().filter(|(_, m)| !m.still) {
-            let own = self.grid.circle_in_slot(index);
+        // The flying balls in the order of the step's input, not by slot: the overlaps found
+        // here are pushed apart in the order found, and a pile settles by that order.
+        self.slot_of.clear();
+        self.slot_of.resize(self.order.len(), 0);
+        for (slot, &index) in self.order.iter().enumerate() {
+            self.slot_of[index as usize] = slot as u32;
+        }
+        let (movers, order, found) = (&self.movers, &self.order, &mut self.predictions);
+        for &slot in &self.slot_of {
+            let slot = slot as usize;
+            if movers[slot].still {
+                continue;
+            }
+            let own = self.grid.circle_in_slot(slot);
             self.grid
                 .for_each_that_may_touch(own, |other, other_swept| {
-                    let other_flies = !movers[other as usize].still;
-                    // A pair of flying balls is taken from its lower index.
-                    if other as usize == index
-                        || (other_flies && (other as usize) < index)
+                    let other = other as usize;
+                    // A pair of flying balls is taken from the one of lower index.
+                    if other == slot
+                        || (!movers[other].still && order[other] < order[slot])
                         || !circles_touch(own, other_swept)
                     {
                         return;
                     }
-                    let pair = ((index as u32).min(other), (index as u32).max(other));
-                    predict_pair(movers, pair, dt, found);
+                    let pair = (slot.min(other) as u32, slot.max(other) as u32);
+                    predict_pair((movers, order), pair, dt, found);
                 });
         }
     }
@@ -120,19 +131,15 @@ impl Timeline {
         if let Some((time, wall)) = wall_time(&mover, spec)
             && now + time <= spec.dt
         {
-            queue.push(Reverse(Impact::with_wall(
-                now + time,
-                index,
-                mover.hits,
-                wall,
-            )));
+            let ball = (index, self.order[index], mover.hits);
+            queue.push(Reverse(Impact::with_wall(now + time, ball, wall)));
         }
         let rest = spec.dt - now;
         let mut swept = swept_by(&mover, rest);
         swept.radius += SWEPT_MARGIN;
         self.rerouted
             .insert(&self.grid, index as u32, mover.hits, swept);
-        let movers = &self.movers;
+        let (movers, order) = (&self.movers, &self.order);
         let mut consider = |other: u32| {
             let other_index = other as usize;
             if other_index == index {
@@ -144,8 +151,8 @@ impl Timeline {
             };
             queue.push(Reverse(Impact::between(
                 time,
-                (index, mover.hits),
-                (other_index, other_mover.hits),
+                (index, order[index], mover.hits),
+                (other_index, order[other_index], other_mover.hits),
             )));
         };
         // Balls on their first path of the step are filed in the grid by the circle that path
@@ -217,15 +224,21 @@ fn wall_time(mover: &Mover, spec: StepSpec) -> Option<(f64, crate::sim::geometry
 /// only.
 const FEW_FLYING: usize = 4;
 
-/// What the search finds for the pair `(a, b)`, `a < b`: an overlap at the start, an impact
-/// within the step.
-fn predict_pair(movers: &[Mover], (a, b): (u32, u32), dt: f64, found: &mut Vec<Prediction>) {
+/// What the search finds for the pair of slots `(a, b)`, `a < b`: an overlap at the start, an
+/// impact within the step. `order` gives each slot's index in the step's input.
+fn predict_pair(
+    (movers, order): (&[Mover], &[u32]),
+    (a, b): (u32, u32),
+    dt: f64,
+    found: &mut Vec<Prediction>,
+) {
     let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
     if overlapping(mover_a.circle(), mover_b.circle()) {
         found.push(Prediction::Overlap(a, b));
     }
     if let Some(time) = pair_time(mover_a, mover_b, 0.0, dt) {
-        let impact = Impact::between(time, (a as usize, 0), (b as usize, 0));
+        let (a, b) = (a as usize, b as usize);
+        let impact = Impact::between(time, (a, order[a], 0), (b, order[b], 0));
         found.push(Prediction::Impact(impact));
     }
 }

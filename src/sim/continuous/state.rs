@@ -142,6 +142,8 @@ pub struct Timeline {
     pub(super) grid: UniformGrid,
     /// The ball in each slot: `order[slot]` is its index in the arrays the step was given.
     pub(super) order: Vec<u32>,
+    /// The inverse of `order`, when a step needs it (a pile's search around the flying).
+    pub(super) slot_of: Vec<u32>,
     /// Each ball's swept circle by index, to sort into the grid.
     pub(super) swept: Vec<Circle>,
     pub(super) predictions: Vec<Prediction>,

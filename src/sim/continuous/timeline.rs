@@ -145,11 +145,8 @@ impl Timeline {
     /// centres if they still approach, or come to rest on each other if slower than the
     /// resting speed.
     fn collide(&mut self, impact: Impact, spec: StepSpec, on_hit: &mut impl FnMut(Hit)) {
-        // The pair in the order of the balls' indices, whatever their slots.
-        let (mut a, mut b, now) = (impact.a as usize, impact.other as usize, impact.time);
-        if self.order[a] > self.order[b] {
-            (a, b) = (b, a);
-        }
+        // `a` is the one of lower index in the step's input, whatever their slots.
+        let (a, b, now) = (impact.a as usize, impact.other as usize, impact.time);
         self.movers[a].advance(now);
         self.movers[b].advance(now);
         let (ma, mb) = (self.movers[a], self.movers[b]);

@@ -105,7 +105,6 @@ pub fn rest_and_sleep(
 ) {
     let (dt, rest_speed) = (clock.dt, rest_speed(&params, clock.dt));
     let state = &mut *state;
-    read_rests(&snapshot.entities, &balls, &mut state.rests);
     let key = MotionKey {
         gravity: params.gravity,
         restitution: params.restitution,
@@ -114,11 +113,13 @@ pub fn rest_and_sleep(
         mode: solver.collisions,
     };
     let changed = state.last_key.replace(key).is_some_and(|last| last != key);
-    let anyone_held = state.rests.iter().any(Rest::is_held);
+    // Read from the components in place: the elastic gas then never copies a ball's `Rest`.
+    let anyone_held = balls.iter().any(|(.., rest)| rest.is_held());
     if rest_speed == 0.0 && !anyone_held {
         state.warm.clear();
         return; // the rule is off and nobody rests: the elastic paths stay untouched
     }
+    read_rests(&snapshot.entities, &balls, &mut state.rests);
     state.wake_all |= changed || rest_speed == 0.0;
     let snapshot = &mut *snapshot;
     if changed {
