@@ -59,7 +59,8 @@ impl Timeline {
             self.predict_every_pair(dt);
         }
         for ((slot, mover), &index) in self.movers.iter().enumerate().zip(&self.order) {
-            if let Some((time, wall)) = wall_time(mover, spec)
+            let swept = self.grid.circle_in_slot(slot);
+            if let Some((time, wall)) = wall_time(mover, swept, spec)
                 && time <= dt
             {
                 let impact = Impact::with_wall(time, (slot, index, 0), wall);
@@ -127,16 +128,16 @@ impl Timeline {
             self.cut_short = true;
             return;
         }
+        let rest = spec.dt - now;
+        let mut swept = swept_by(&mover, rest);
+        swept.radius += SWEPT_MARGIN;
         let queue = &mut self.queue;
-        if let Some((time, wall)) = wall_time(&mover, spec)
+        if let Some((time, wall)) = wall_time(&mover, swept, spec)
             && now + time <= spec.dt
         {
             let ball = (index, self.order[index], mover.hits);
             queue.push(Reverse(Impact::with_wall(now + time, ball, wall)));
         }
-        let rest = spec.dt - now;
-        let mut swept = swept_by(&mover, rest);
-        swept.radius += SWEPT_MARGIN;
         self.rerouted
             .insert(&self.grid, index as u32, mover.hits, swept);
         let (movers, order) = (&self.movers, &self.order);
@@ -206,9 +207,15 @@ pub(super) fn pair_time(a: &Mover, b: &Mover, now: f64, end: f64) -> Option<f64>
     time.map(|t| now + t).filter(|&t| t <= end)
 }
 
-/// When a moving `mover` first meets a wall, from its clock on; a still one meets none.
-fn wall_time(mover: &Mover, spec: StepSpec) -> Option<(f64, crate::sim::geometry::Wall)> {
-    if mover.still {
+/// When a moving `mover` first meets a wall, from its clock on; a still one meets none, and
+/// nor does one whose path, bounded by the circle `swept`, stays clear of every wall.
+fn wall_time(
+    mover: &Mover,
+    swept: Circle,
+    spec: StepSpec,
+) -> Option<(f64, crate::sim::geometry::Wall)> {
+    let clear = (swept.center.abs() + DVec2::splat(swept.radius + SWEPT_MARGIN)).cmplt(spec.half);
+    if mover.still || clear.all() {
         return None;
     }
     wall_time_of_impact(

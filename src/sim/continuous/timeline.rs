@@ -131,7 +131,7 @@ impl Timeline {
         mover.accel = spec.gravity;
         mover.hits += 1;
         on_hit(Hit::Wall {
-            ball: self.order[a],
+            ball: impact.order.0,
             wall,
             time: now,
             point: bounce.point,
@@ -176,8 +176,8 @@ impl Timeline {
         self.movers[a].hits += 1;
         self.movers[b].hits += 1;
         on_hit(Hit::Ball {
-            a: self.order[a],
-            b: self.order[b],
+            a: impact.order.0,
+            b: impact.order.1,
             time: now,
             point: collision_point(ma.circle(), mb.circle()),
             normal,
