@@ -126,6 +126,7 @@ impl Timeline {
         if mover.hits == MAX_HITS_PER_BALL {
             // No more impacts for this ball this step: the end-of-step fallback takes over.
             self.cut_short = true;
+            self.paths.end(index as u32);
             return;
         }
         let rest = spec.dt - now;
@@ -138,10 +139,10 @@ impl Timeline {
             let ball = (index, self.order[index], mover.hits);
             queue.push(Reverse(Impact::with_wall(now + time, ball, wall)));
         }
-        self.rerouted
-            .insert(&self.grid, index as u32, mover.hits, swept);
+        self.paths
+            .redirect(&self.grid, index as u32, mover.hits, swept);
         let (movers, order) = (&self.movers, &self.order);
-        let mut consider = |other: u32| {
+        let consider = |other: u32| {
             let other_index = other as usize;
             if other_index == index {
                 return;
@@ -156,19 +157,10 @@ impl Timeline {
                 (other_index, order[other_index], other_mover.hits),
             )));
         };
-        // Balls on their first path of the step are filed in the grid by the circle that path
-        // sweeps; the ones that changed course since, in `rerouted`. Both filters are the
-        // swept circles: if they do not touch, neither can the balls.
-        self.grid
-            .for_each_that_may_touch(swept, |other, other_swept| {
-                // The swept circle first: it sits in the grid's contiguous cells, while the hit
-                // count is a read from anywhere in `movers`.
-                if circles_touch(swept, other_swept) && movers[other as usize].hits == 0 {
-                    consider(other);
-                }
-            });
+        // Every ball's current path is known by the circle it sweeps: if two do not touch,
+        // neither can the balls.
         let hits_of = |ball: u32| movers[ball as usize].hits;
-        self.rerouted
+        self.paths
             .for_each_that_may_touch(&self.grid, swept, hits_of, consider);
     }
 }

@@ -9,7 +9,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::impact::{Impact, Prediction};
-use super::rerouted::Rerouted;
+use super::paths::Paths;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
@@ -152,7 +152,7 @@ pub struct Timeline {
     /// Every ball on this step's timeline, by slot: all a prediction reads of one ball in
     /// one cache line.
     pub(super) movers: Vec<Mover>,
-    pub(super) rerouted: Rerouted,
+    pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.
     pub(super) fallback: Vec<IndexedContact>,
     /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].

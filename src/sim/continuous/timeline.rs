@@ -62,7 +62,7 @@ impl Timeline {
     /// Every ball at the start of the step (placed by [`predict`](Self::predict)), no hits
     /// yet; the predictions queued.
     fn start(&mut self) {
-        self.rerouted.reset(self.grid.cell_count());
+        self.paths.reset(&self.grid);
         self.queue.clear();
         self.overlapping.clear();
         for prediction in &self.predictions {

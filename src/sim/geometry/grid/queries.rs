@@ -56,6 +56,11 @@ impl UniformGrid {
     pub fn for_each_that_may_touch(&self, circle: Circle, mut visit: impl FnMut(u32, Circle)) {
         let near = DVec2::splat(circle.radius + self.small_reach);
         self.visit_cells_in_box(circle.center - near, circle.center + near, &mut visit);
+        self.for_each_big_that_may_touch(circle, visit);
+    }
+
+    /// The big balls' part of [`for_each_that_may_touch`](Self::for_each_that_may_touch).
+    pub fn for_each_big_that_may_touch(&self, circle: Circle, mut visit: impl FnMut(u32, Circle)) {
         if let Some(big) = self.big_grid() {
             let index = |k: u32| self.sorted_index[self.small_count + k as usize];
             big.visit_may_touch_dyn(circle, &mut |k, other| visit(index(k), other));

@@ -167,6 +167,21 @@ impl UniformGrid {
         self.sorted_circle[slot]
     }
 
+    /// Every ball's circle, by slot.
+    pub fn circles_by_slot(&self) -> &[Circle] {
+        &self.sorted_circle
+    }
+
+    /// How many balls are in the cells: slots `0..small_count()`; the big ones follow.
+    pub fn small_count(&self) -> usize {
+        self.small_count
+    }
+
+    /// The largest radius of a ball in the cells.
+    pub fn small_reach(&self) -> f64 {
+        self.small_reach
+    }
+
     /// Number of balls sorted in.
     pub fn len(&self) -> usize {
         self.sorted_index.len()
@@ -282,8 +297,9 @@ impl UniformGrid {
         }
     }
 
-    /// The slots of the balls in the consecutive cells `cells`.
-    pub(super) fn slots_of(&self, cells: std::ops::Range<usize>) -> std::ops::Range<usize> {
+    /// The slots of the balls in the consecutive cells `cells` (the cells hold the slots
+    /// `0..small_count()`).
+    pub fn slots_of(&self, cells: std::ops::Range<usize>) -> std::ops::Range<usize> {
         self.cell_start[cells.start] as usize..self.cell_start[cells.end] as usize
     }
 }

@@ -1,0 +1,176 @@
+//! The rest of each ball's path during a continuous step, as the circle it sweeps until the
+//! step ends, kept by slot (the grid's cell order), so that a ball redirected by an impact
+//! finds every ball whose path may cross its new one by reading the grid's cells around it:
+//! one pass over contiguous memory, whether those balls flew straight or were redirected.
+//!
+//! A redirected ball stays in the cell of its first path; its new circle may reach further
+//! from that cell, and [`Paths::reach`] grows to cover it. A path reaching too far (or a big
+//! ball's, which has no cell) is kept apart in a short list instead.
+
+use bevy::math::DVec2;
+
+use crate::sim::geometry::Circle;
+use crate::sim::geometry::circle::circles_touch;
+use crate::sim::geometry::grid::UniformGrid;
+
+/// Each ball's current path, by slot.
+#[derive(Debug, Default)]
+pub struct Paths {
+    /// By slot, for the balls in the grid's cells: the circle the rest of the ball's path
+    /// sweeps (its first path's, from the grid, until an impact redirects it); one that
+    /// touches nothing while the ball's path is kept in `far`.
+    current: Vec<Circle>,
+    /// How far, along either axis, a current circle reaches beyond its ball's first centre
+    /// (the one that files it in its cell): a query grown by this finds every circle it
+    /// touches.
+    reach: f64,
+    /// A redirected circle reaching further than this goes to `far`.
+    far_limit: f64,
+    /// The paths kept apart: big balls' and far-reaching ones.
+    far: Vec<FarPath>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct FarPath {
+    slot: u32,
+    /// The ball's hits when it took this path: the entry is current while they still are.
+    hits: u32,
+    swept: Circle,
+}
+
+/// A circle no other touches: the place of a path kept in `far`.
+const NOWHERE: Circle = Circle {
+    center: DVec2::splat(f64::NAN),
+    radius: f64::NAN,
+};
+
+impl Paths {
+    /// Every ball on its first path: the circles `grid` holds.
+    pub fn reset(&mut self, grid: &UniformGrid) {
+        self.current.clear();
+        self.current
+            .extend_from_slice(&grid.circles_by_slot()[..grid.small_count()]);
+        self.reach = grid.small_reach();
+        self.far_limit = grid.big_limit();
+        self.far.clear();
+    }
+
+    /// Ball `slot`, which now has `hits` hits, takes a new path that sweeps `swept`.
+    pub fn redirect(&mut self, grid: &UniformGrid, slot: u32, hits: u32, swept: Circle) {
+        let index = slot as usize;
+        let keep_apart = |reach: f64| reach > self.far_limit;
+        if index < self.current.len() {
+            let first = grid.circle_in_slot(index).center;
+            let reach = (swept.center - first).abs().max_element() + swept.radius;
+            if !keep_apart(reach) {
+                self.current[index] = swept;
+                self.reach = self.reach.max(reach);
+                return;
+            }
+            self.current[index] = NOWHERE;
+        }
+        self.far.push(FarPath { slot, hits, swept });
+    }
+
+    /// Ball `slot` takes no more impacts this step: no path of it is found any more.
+    pub fn end(&mut self, slot: u32) {
+        if let Some(current) = self.current.get_mut(slot as usize) {
+            *current = NOWHERE;
+        }
+    }
+
+    /// Calls `visit(slot)` for every ball whose current path's circle touches `swept`, once
+    /// each. `hits_of(slot)` gives a ball's hits now.
+    pub fn for_each_that_may_touch(
+        &self,
+        grid: &UniformGrid,
+        swept: Circle,
+        hits_of: impl Fn(u32) -> u32,
+        mut visit: impl FnMut(u32),
+    ) {
+        let near = DVec2::splat(swept.radius + self.reach);
+        grid.for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
+            let slots = grid.slots_of(cells);
+            let first = slots.start;
+            for (offset, &circle) in self.current[slots].iter().enumerate() {
+                if circles_touch(swept, circle) {
+                    visit((first + offset) as u32);
+                }
+            }
+        });
+        // Big balls on their first path, through their own grid; then the paths kept apart.
+        grid.for_each_big_that_may_touch(swept, |slot, circle| {
+            if hits_of(slot) == 0 && circles_touch(swept, circle) {
+                visit(slot);
+            }
+        });
+        for path in &self.far {
+            if circles_touch(swept, path.swept) && hits_of(path.slot) == path.hits {
+                visit(path.slot);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slots whose current path touches `probe`, sorted.
+    fn found(paths: &Paths, grid: &UniformGrid, probe: Circle, hits: &[u32]) -> Vec<u32> {
+        let mut slots = Vec::new();
+        paths.for_each_that_may_touch(
+            grid,
+            probe,
+            |slot| hits[slot as usize],
+            |slot| slots.push(slot),
+        );
+        slots.sort_unstable();
+        slots
+    }
+
+    #[test]
+    fn a_redirected_path_is_found_where_it_goes_not_where_it_was() {
+        // 20 x 20 balls of radius 2, 10 px apart: the grid's limit for big is 8 px.
+        let circles: Vec<Circle> = (0..400)
+            .map(|k| Circle::new(DVec2::new((k % 20) as f64, (k / 20) as f64) * 10.0, 2.0))
+            .collect();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut order = Vec::new();
+        grid.renumber_by_slot(&mut order);
+        let mut paths = Paths::default();
+        paths.reset(&grid);
+        let slot_at = |center: DVec2| {
+            let index = circles.iter().position(|c| c.center == center).unwrap();
+            order.iter().position(|&k| k as usize == index).unwrap() as u32
+        };
+        let (near, far) = (
+            slot_at(DVec2::new(50.0, 50.0)),
+            slot_at(DVec2::new(100.0, 100.0)),
+        );
+        let mut hits = vec![0; 400];
+        // One moves 4 px (it stays in reach), the other 60 px (kept apart).
+        let (near_path, far_path) = (
+            Circle::new(DVec2::new(54.0, 50.0), 3.0),
+            Circle::new(DVec2::new(160.0, 100.0), 3.0),
+        );
+        hits[near as usize] = 1;
+        paths.redirect(&grid, near, 1, near_path);
+        hits[far as usize] = 1;
+        paths.redirect(&grid, far, 1, far_path);
+        assert_eq!(paths.far.len(), 1);
+        // A probe beside the new paths finds them; one at the old place of the far one does not.
+        let beside_near = Circle::new(DVec2::new(57.5, 50.0), 1.0);
+        assert!(found(&paths, &grid, beside_near, &hits).contains(&near));
+        let beside_far = Circle::new(DVec2::new(163.5, 100.0), 1.0);
+        assert!(found(&paths, &grid, beside_far, &hits).contains(&far));
+        let old_place = Circle::new(DVec2::new(100.0, 100.0), 1.0);
+        assert!(!found(&paths, &grid, old_place, &hits).contains(&far));
+        // Another hit makes the far entry stale; a ball taking no more impacts is found nowhere.
+        hits[far as usize] = 2;
+        assert!(!found(&paths, &grid, beside_far, &hits).contains(&far));
+        paths.end(near);
+        assert!(!found(&paths, &grid, beside_near, &hits).contains(&near));
+    }
+}
