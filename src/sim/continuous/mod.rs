@@ -12,8 +12,8 @@
 //!   wall time of impact within the step, found through the grid of swept circles
 //!   ([`impact`] holds what a prediction is);
 //! - stage 3, [`run_timeline`] ([`timeline`]): the impacts in time order, predicting anew for
-//!   the balls each one redirects (`paths.rs` keeps every ball's current path by slot), then every ball to the end of
-//!   the step, and the balls written back.
+//!   the balls each one redirects (`paths.rs` keeps every ball's current path by slot), then
+//!   every ball to the end of the step, and the balls written back.
 //!
 //! [`state`] holds the [`Timeline`] resource both halves work on.
 //!

@@ -18,15 +18,18 @@ use crate::sim::geometry::grid::UniformGrid;
 pub struct Paths {
     /// By slot, for the balls in the grid's cells: the circle the rest of the ball's path
     /// sweeps (its first path's, from the grid, until an impact redirects it); one that
-    /// touches nothing while the ball's path is kept in `far`.
+    /// touches nothing while the ball's path is kept in `far`, or once it takes no more
+    /// impacts this step ([`end`](Self::end)).
     current: Vec<Circle>,
-    /// How far, along either axis, a current circle reaches beyond its ball's first centre
+    /// How far, along either axis, a current circle reaches from its ball's first centre
     /// (the one that files it in its cell): a query grown by this finds every circle it
-    /// touches.
+    /// touches. It only grows during a step, at most to `far_limit`.
     reach: f64,
     /// A redirected circle reaching further than this goes to `far`.
     far_limit: f64,
-    /// The paths kept apart: big balls' and far-reaching ones.
+    /// The paths kept apart: big balls' and far-reaching ones. Stale entries stay until the
+    /// step ends (skipped by their hit count); a ball takes at most
+    /// [`MAX_HITS_PER_BALL`](super::state::MAX_HITS_PER_BALL) paths a step, and few reach far.
     far: Vec<FarPath>,
 }
 
@@ -57,17 +60,16 @@ impl Paths {
 
     /// Ball `slot`, which now has `hits` hits, takes a new path that sweeps `swept`.
     pub fn redirect(&mut self, grid: &UniformGrid, slot: u32, hits: u32, swept: Circle) {
-        let index = slot as usize;
         let keep_apart = |reach: f64| reach > self.far_limit;
-        if index < self.current.len() {
-            let first = grid.circle_in_slot(index).center;
+        if let Some(current) = self.current.get_mut(slot as usize) {
+            let first = grid.circle_in_slot(slot as usize).center;
             let reach = (swept.center - first).abs().max_element() + swept.radius;
             if !keep_apart(reach) {
-                self.current[index] = swept;
+                *current = swept;
                 self.reach = self.reach.max(reach);
                 return;
             }
-            self.current[index] = NOWHERE;
+            *current = NOWHERE;
         }
         self.far.push(FarPath { slot, hits, swept });
     }
@@ -100,7 +102,7 @@ impl Paths {
         });
         // Big balls on their first path, through their own grid; then the paths kept apart.
         grid.for_each_big_that_may_touch(swept, |slot, circle| {
-            if hits_of(slot) == 0 && circles_touch(swept, circle) {
+            if circles_touch(swept, circle) && hits_of(slot) == 0 {
                 visit(slot);
             }
         });
@@ -172,5 +174,35 @@ mod tests {
         assert!(!found(&paths, &grid, beside_far, &hits).contains(&far));
         paths.end(near);
         assert!(!found(&paths, &grid, beside_near, &hits).contains(&near));
+    }
+
+    #[test]
+    fn a_big_ball_s_path_is_kept_apart_and_found_until_it_is_hit_again() {
+        let circles = crate::sim::geometry::grid::mixed_sizes();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut order = Vec::new();
+        grid.renumber_by_slot(&mut order);
+        let mut paths = Paths::default();
+        paths.reset(&grid);
+        // The ball of radius 200 is big: its slot lies past the cells'.
+        let big = order
+            .iter()
+            .position(|&k| k as usize == circles.len() - 1)
+            .unwrap() as u32;
+        assert!(big as usize >= grid.small_count());
+        let mut hits = vec![0; circles.len()];
+        hits[big as usize] = 1;
+        let moved = Circle::new(DVec2::new(260.0, 300.0), 205.0);
+        paths.redirect(&grid, big, 1, moved);
+        assert_eq!(paths.far.len(), 1);
+        let beside = Circle::new(DVec2::new(260.0, 507.0), 3.0);
+        assert!(found(&paths, &grid, beside, &hits).contains(&big));
+        // Its first path is no longer found (it has been hit), nor, after another hit, this one.
+        let first_only = Circle::new(DVec2::new(210.0, 55.0), 1.0);
+        assert!(!found(&paths, &grid, first_only, &hits).contains(&big));
+        hits[big as usize] = 2;
+        paths.end(big);
+        assert!(!found(&paths, &grid, beside, &hits).contains(&big));
     }
 }

@@ -13,7 +13,7 @@ use std::cmp::Reverse;
 
 use bevy::math::DVec2;
 
-use super::impact::{Impact, Prediction, approach_time, swept_circle};
+use super::impact::{Impact, Party, Prediction, approach_time, swept_circle};
 use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circles_touch, overlapping};
 use crate::sim::geometry::flight::time_to_touch;
@@ -63,7 +63,12 @@ impl Timeline {
             if let Some((time, wall)) = wall_time(mover, swept, spec)
                 && time <= dt
             {
-                let impact = Impact::with_wall(time, (slot, index, 0), wall);
+                let ball = Party {
+                    slot,
+                    index,
+                    hits: 0,
+                };
+                let impact = Impact::with_wall(time, ball, wall);
                 self.predictions.push(Prediction::Impact(impact));
             }
         }
@@ -120,46 +125,55 @@ impl Timeline {
         }
     }
 
-    /// Queues ball `index`'s next wall and ball impacts after its velocity changed at `now`.
-    pub(super) fn predict_for(&mut self, index: usize, now: f64, spec: StepSpec) {
-        let mover = self.movers[index];
+    /// Queues the next wall and ball impacts of the ball in `slot`, whose velocity changed
+    /// at `now`.
+    pub(super) fn predict_for(&mut self, slot: usize, now: f64, spec: StepSpec) {
+        let mover = self.movers[slot];
         if mover.hits == MAX_HITS_PER_BALL {
             // No more impacts for this ball this step: the end-of-step fallback takes over.
             self.cut_short = true;
-            self.paths.end(index as u32);
+            self.paths.end(slot as u32);
             return;
         }
         let rest = spec.dt - now;
         let mut swept = swept_by(&mover, rest);
         swept.radius += SWEPT_MARGIN;
-        let queue = &mut self.queue;
+        let (queue, order) = (&mut self.queue, &self.order);
+        let party = |slot: usize, mover: &Mover| Party {
+            slot,
+            index: order[slot],
+            hits: mover.hits,
+        };
         if let Some((time, wall)) = wall_time(&mover, swept, spec)
             && now + time <= spec.dt
         {
-            let ball = (index, self.order[index], mover.hits);
-            queue.push(Reverse(Impact::with_wall(now + time, ball, wall)));
+            queue.push(Reverse(Impact::with_wall(
+                now + time,
+                party(slot, &mover),
+                wall,
+            )));
         }
         self.paths
-            .redirect(&self.grid, index as u32, mover.hits, swept);
-        let (movers, order) = (&self.movers, &self.order);
+            .redirect(&self.grid, slot as u32, mover.hits, swept);
+        let movers = &self.movers;
         let consider = |other: u32| {
-            let other_index = other as usize;
-            if other_index == index {
+            let other_slot = other as usize;
+            if other_slot == slot {
                 return;
             }
-            let other_mover = &movers[other_index];
+            let other_mover = &movers[other_slot];
             let Some(time) = pair_time(&mover, other_mover, now, spec.dt) else {
                 return;
             };
             queue.push(Reverse(Impact::between(
                 time,
-                (index, order[index], mover.hits),
-                (other_index, order[other_index], other_mover.hits),
+                party(slot, &mover),
+                party(other_slot, other_mover),
             )));
         };
         // Every ball's current path is known by the circle it sweeps: if two do not touch,
         // neither can the balls.
-        let hits_of = |ball: u32| movers[ball as usize].hits;
+        let hits_of = |other: u32| movers[other as usize].hits;
         self.paths
             .for_each_that_may_touch(&self.grid, swept, hits_of, consider);
     }
@@ -200,7 +214,8 @@ pub(super) fn pair_time(a: &Mover, b: &Mover, now: f64, end: f64) -> Option<f64>
 }
 
 /// When a moving `mover` first meets a wall, from its clock on; a still one meets none, and
-/// nor does one whose path, bounded by the circle `swept`, stays clear of every wall.
+/// nor does one whose path, bounded by the circle `swept`, stays clear of every wall by
+/// [`SWEPT_MARGIN`] (its own margin, against rounding).
 fn wall_time(
     mover: &Mover,
     swept: Circle,
@@ -236,8 +251,12 @@ fn predict_pair(
         found.push(Prediction::Overlap(a, b));
     }
     if let Some(time) = pair_time(mover_a, mover_b, 0.0, dt) {
-        let (a, b) = (a as usize, b as usize);
-        let impact = Impact::between(time, (a, order[a], 0), (b, order[b], 0));
+        let party = |slot: u32| Party {
+            slot: slot as usize,
+            index: order[slot as usize],
+            hits: 0,
+        };
+        let impact = Impact::between(time, party(a), party(b));
         found.push(Prediction::Impact(impact));
     }
 }
@@ -301,5 +320,55 @@ mod tests {
         let every = sorted(&timeline.predictions);
         assert!(around.len() > 20, "{} predictions", around.len());
         assert_eq!(around, every);
+    }
+
+    #[test]
+    fn skipping_the_walls_out_of_reach_finds_every_wall_impact_the_full_search_finds() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let spec = StepSpec {
+            dt: 1.0 / 60.0,
+            half: DVec2::new(200.0, 150.0),
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+            gravity: DVec2::new(0.0, -900.0),
+            rest_speed: 0.0,
+        };
+        let mut reached = 0;
+        for case in 0..4000 {
+            let radius = rng.random_range(2.0..20.0);
+            let limit = spec.half - DVec2::splat(radius);
+            // Anywhere inside, a few on or just past a wall.
+            let center = DVec2::new(
+                rng.random_range(-limit.x..limit.x),
+                rng.random_range(-limit.y..limit.y),
+            ) * if case % 10 == 0 { 1.02 } else { 1.0 };
+            let velocity = DVec2::new(
+                rng.random_range(-3000.0..3000.0),
+                rng.random_range(-3000.0..3000.0),
+            );
+            let mut mover = Mover::new(Circle::new(center, radius), velocity, spec.gravity, false);
+            if case % 7 == 0 {
+                // Sliding along the floor, as after stopping against it.
+                mover.center.y = -limit.y;
+                mover.velocity.y = 0.0;
+                mover.accel = DVec2::ZERO;
+            }
+            let horizon = rng.random_range(0.001..spec.dt);
+            let mut swept = swept_by(&mover, horizon);
+            swept.radius += SWEPT_MARGIN;
+            let within = |found: Option<(f64, crate::sim::geometry::Wall)>| {
+                found.filter(|&(time, _)| time <= horizon)
+            };
+            let full = within(wall_time_of_impact(
+                mover.center,
+                mover.velocity,
+                mover.radius,
+                spec.half,
+                mover.accel,
+            ));
+            reached += usize::from(full.is_some());
+            assert_eq!(within(wall_time(&mover, swept, spec)), full, "case {case}");
+        }
+        assert!(reached > 200, "{reached} of the cases reach a wall");
     }
 }

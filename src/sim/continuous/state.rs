@@ -148,6 +148,7 @@ pub struct Timeline {
     pub(super) swept: Vec<Circle>,
     pub(super) predictions: Vec<Prediction>,
     pub(super) queue: BinaryHeap<Reverse<Impact>>,
+    /// The pairs that overlapped at the start of the step, by input index, lower first.
     pub(super) overlapping: Vec<(u32, u32)>,
     /// Every ball on this step's timeline, by slot: all a prediction reads of one ball in
     /// one cache line.

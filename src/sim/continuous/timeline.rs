@@ -131,7 +131,7 @@ impl Timeline {
         mover.accel = spec.gravity;
         mover.hits += 1;
         on_hit(Hit::Wall {
-            ball: impact.order.0,
+            ball: impact.indices.0,
             wall,
             time: now,
             point: bounce.point,
@@ -176,8 +176,8 @@ impl Timeline {
         self.movers[a].hits += 1;
         self.movers[b].hits += 1;
         on_hit(Hit::Ball {
-            a: impact.order.0,
-            b: impact.order.1,
+            a: impact.indices.0,
+            b: impact.indices.1,
             time: now,
             point: collision_point(ma.circle(), mb.circle()),
             normal,
@@ -218,28 +218,28 @@ impl Timeline {
         }
     }
 
-    /// A flying ball `index` meets a still one faster than the resting speed: the still one
+    /// The flying ball in `slot` meets a still one faster than the resting speed: the still one
     /// rests in a pile the contact solver holds, where an impact is a simultaneous problem
     /// (every contact of the pile at once, as Box2D solves it), not a chain of pairwise
     /// exchanges. So the flying ball stops at the contact, keeping its velocity, and joins
     /// the solver at the next step, whose restitution pass bounces it off the pile.
-    fn stop_for_the_solver(&mut self, index: usize, now: f64, spec: StepSpec) {
-        let mover = &mut self.movers[index];
+    fn stop_for_the_solver(&mut self, slot: usize, now: f64, spec: StepSpec) {
+        let mover = &mut self.movers[slot];
         mover.still = true;
         mover.accel = DVec2::ZERO;
         mover.hits += 1;
-        self.predict_for(index, now, spec);
+        self.predict_for(slot, now, spec);
     }
 
-    /// Ball `index` stops on a support that holds still (towards `into`, unit): it keeps only
+    /// The ball in `slot` stops on a support that holds still (towards `into`, unit): it keeps only
     /// its velocity along the support's surface, for the end of the step, and holds still.
-    fn stop_on_support(&mut self, index: usize, into: DVec2, now: f64, spec: StepSpec) {
-        let mover = &mut self.movers[index];
+    fn stop_on_support(&mut self, slot: usize, into: DVec2, now: f64, spec: StepSpec) {
+        let mover = &mut self.movers[slot];
         mover.velocity -= into * mover.velocity.dot(into).max(0.0);
         mover.still = true;
         mover.accel = DVec2::ZERO;
         mover.hits += 1;
-        self.predict_for(index, now, spec);
+        self.predict_for(slot, now, spec);
     }
 
     /// Every ball where the end of the step finds it. A held ball stays held if nothing hit

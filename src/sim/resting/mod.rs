@@ -119,6 +119,7 @@ pub fn rest_and_sleep(
         state.warm.clear();
         return; // the rule is off and nobody rests: the elastic paths stay untouched
     }
+    // Read here, after the early return: `state.rests` is only used below it.
     read_rests(&snapshot.entities, &balls, &mut state.rests);
     state.wake_all |= changed || rest_speed == 0.0;
     let snapshot = &mut *snapshot;

@@ -2,15 +2,15 @@
 //!
 //! Used by both modes' collision stages (the discrete mode sorts the balls' circles, the
 //! continuous mode the circles they sweep over the step, and also queries around a circle).
-//! Two methods find the same pairs: [`UniformGrid`] ([`uniform`]), O(N), the default, with
-//! its queries around a place in [`queries`], its cells' geometry in [`cells`] and the few big
-//! balls kept apart by rows in [`rows`]; and
-//! [`for_each_pair`], O(N^2), kept as the reference the grid is tested against.
+//! Two methods find the same pairs: [`UniformGrid`] (`uniform.rs`), O(N), the default, with
+//! its queries around a place in `queries.rs`, its cells' geometry in `cells.rs` and the few
+//! big balls kept apart by rows in `rows.rs`; and [`for_each_pair`], O(N^2), kept as the
+//! reference the grid is tested against.
 
-pub mod cells;
-pub mod queries;
-pub mod rows;
-pub mod uniform;
+mod cells;
+mod queries;
+mod rows;
+mod uniform;
 
 pub use uniform::UniformGrid;
 

@@ -1,6 +1,7 @@
-//! The grid's queries around a place: the cells of a box, the balls whose centres lie in a
-//! box, and the balls that may touch a circle, the big ones (kept apart in a grid of their
-//! own) included. The continuous mode asks them for each ball an impact redirects.
+//! The grid's queries around a place: the cells of a box, and the balls that may touch a
+//! circle, the big ones (kept apart in a grid of their own) included. The continuous mode
+//! searches around its flying balls with the second, and its `Paths` read the cells of a box
+//! and the big balls' part for each ball an impact redirects.
 
 use bevy::math::DVec2;
 
@@ -8,17 +9,6 @@ use super::uniform::UniformGrid;
 use crate::sim::geometry::circle::Circle;
 
 impl UniformGrid {
-    /// Number of cells: [`cell_index`](Self::cell_index) is below it.
-    pub fn cell_count(&self) -> usize {
-        self.cells.cell_count()
-    }
-
-    /// The cell holding `point`. A point outside the grid goes to the nearest border cell, so
-    /// the cell order along each axis never contradicts the points' order.
-    pub fn cell_index(&self, point: DVec2) -> usize {
-        self.cells.cell_index(point)
-    }
-
     /// Calls `visit(cells)` with runs of consecutive cell indices that together cover every
     /// cell overlapping the box `[min, max]`: one run per row.
     pub fn for_each_cell_run_in_box(
@@ -33,21 +23,6 @@ impl UniformGrid {
             let start = row * self.cells.columns;
             visit(start + first_column..start + last_column + 1);
         }
-    }
-
-    /// Calls `visit(index, circle)` for every ball whose centre lies in the box `[min, max]`,
-    /// and for some just outside it (the rest of their cells). Indices are as in
-    /// [`for_each_candidate_pair`](Self::for_each_candidate_pair).
-    pub fn for_each_near(&self, min: DVec2, max: DVec2, mut visit: impl FnMut(u32, Circle)) {
-        self.visit_cells_in_box(min, max, &mut visit);
-        if let Some(big) = self.big_grid() {
-            let index = |k: u32| self.sorted_index[self.small_count + k as usize];
-            big.visit_near_dyn(min, max, &mut |k, circle| visit(index(k), circle));
-        }
-    }
-
-    fn visit_near_dyn(&self, min: DVec2, max: DVec2, visit: &mut dyn FnMut(u32, Circle)) {
-        self.for_each_near(min, max, visit);
     }
 
     /// Calls `visit(index, circle)` for every ball whose circle may touch `circle`: every one
@@ -91,7 +66,7 @@ mod tests {
     use crate::sim::geometry::grid::mixed_sizes;
 
     #[test]
-    fn a_box_query_finds_every_centre_inside_it() {
+    fn a_circle_query_finds_every_ball_it_touches_inside_across_and_outside_the_grid() {
         let circles: Vec<Circle> = (0..400)
             .map(|i| {
                 let (x, y) = ((i * 37 % 101) as f64 * 3.3, (i * 61 % 97) as f64 * 2.9);
@@ -100,24 +75,30 @@ mod tests {
             .collect();
         let mut grid = UniformGrid::default();
         grid.rebuild(&circles);
-        // Boxes inside, across and wholly outside the grid's extent.
-        for (min, max) in [
-            (DVec2::new(50.0, 40.0), DVec2::new(120.0, 90.0)),
-            (DVec2::new(-500.0, 200.0), DVec2::new(30.0, 1_000.0)),
-            (DVec2::new(400.0, 400.0), DVec2::new(900.0, 900.0)),
+        // Probes inside, across and wholly outside the grid's extent.
+        for probe in [
+            Circle::new(DVec2::new(85.0, 65.0), 40.0),
+            Circle::new(DVec2::new(-100.0, 300.0), 140.0),
+            Circle::new(DVec2::new(700.0, 700.0), 300.0),
         ] {
             let mut visited = std::collections::HashSet::new();
-            grid.for_each_near(min, max, |index, circle| {
+            grid.for_each_that_may_touch(probe, |index, circle| {
                 assert_eq!(circle, circles[index as usize]);
                 assert!(visited.insert(index), "ball {index} visited twice");
             });
-            for (index, circle) in circles.iter().enumerate() {
-                let inside = circle.center.cmpge(min).all() && circle.center.cmple(max).all();
-                assert!(
-                    !inside || visited.contains(&(index as u32)),
-                    "missed {index}"
-                );
+            let touching = circles
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.center.distance(probe.center) <= c.radius + probe.radius);
+            let mut count = 0;
+            for (index, _) in touching {
+                count += 1;
+                assert!(visited.contains(&(index as u32)), "missed {index}");
             }
+            assert!(
+                count > 0 || probe.center.x > 600.0,
+                "the probe touches something"
+            );
         }
     }
 

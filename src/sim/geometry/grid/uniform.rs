@@ -220,7 +220,8 @@ impl UniformGrid {
         rows: std::ops::Range<usize>,
         mut visit: impl FnMut(u32, u32, Circle, Circle),
     ) {
-        if rows.start == 0 {
+        // With the band that holds the first row (a band may be empty: more bands than rows).
+        if rows.contains(&0) {
             self.visit_big_pairs(&mut visit);
         }
         // In row-major order a cell and its right neighbour are adjacent, and the three cells
@@ -383,8 +384,9 @@ mod tests {
         });
         assert!(touching > 300, "{touching} touching pairs");
         // Bands of rows, joined in row order, give the same pairs in the same order.
-        for bands in [2, 3, 7] {
-            let rows = grid.rows();
+        let rows = grid.rows();
+        // More bands than rows, too: some bands are then empty.
+        for bands in [2, 3, 7, rows + 3] {
             let mut joined = Vec::new();
             for band in 0..bands {
                 grid.for_each_candidate_pair_in_rows(
