@@ -184,6 +184,28 @@ impl BenchRow {
     pub fn speedup_from_cores(&self) -> f64 {
         self.one_core.ms_per_step_median / self.all_cores.ms_per_step_median
     }
+
+    /// The continuous mode's speed-up from all cores.
+    pub fn continuous_speedup_from_cores(&self) -> f64 {
+        self.continuous_one_core.ms_per_step_median / self.continuous_all_cores.ms_per_step_median
+    }
+}
+
+/// Each row's cost per ball-step on one core against the first row's, discrete then
+/// continuous: 1.0 is a flat cost per ball.
+pub fn cost_per_ball_against_first(rows: &[BenchRow]) -> Vec<(f64, f64)> {
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    let per_ball = |result: &CaseResult| result.ns_per_ball_step;
+    rows.iter()
+        .map(|row| {
+            (
+                per_ball(&row.one_core) / per_ball(&first.one_core),
+                per_ball(&row.continuous_one_core) / per_ball(&first.continuous_one_core),
+            )
+        })
+        .collect()
 }
 
 /// The bench tables as text: the discrete mode's scaling, then continuous against discrete.
@@ -255,6 +277,36 @@ pub fn format_table(rows: &[BenchRow]) -> String {
                 .map_or("-".to_string(), |mib| format!("{:.1}", mib * 1.048_576)),
         );
     }
+    text + &format_scale(rows)
+}
+
+/// How the cost scales: per ball against the first size, and two cores against one.
+fn format_scale(rows: &[BenchRow]) -> String {
+    let mut text = String::from(
+        "\nScale (one core; per ball against the first size, 1.00x is flat; all cores against one):\n",
+    );
+    text += &format!(
+        "{:>8} {:>12} {:>13} {:>12} {:>13} {:>9} {:>9}\n",
+        "balls",
+        "disc ns/ball",
+        "disc vs first",
+        "cont ns/ball",
+        "cont vs first",
+        "disc 2c",
+        "cont 2c"
+    );
+    for (row, (discrete, continuous)) in rows.iter().zip(cost_per_ball_against_first(rows)) {
+        text += &format!(
+            "{:>8} {:>12.1} {:>12.2}x {:>12.1} {:>12.2}x {:>8.2}x {:>8.2}x\n",
+            row.balls,
+            row.one_core.ns_per_ball_step,
+            discrete,
+            row.continuous_one_core.ns_per_ball_step,
+            continuous,
+            row.speedup_from_cores(),
+            row.continuous_speedup_from_cores(),
+        );
+    }
     text
 }
 
@@ -279,5 +331,47 @@ mod tests {
             );
         }
         assert_eq!(flag_value(BroadPhase::AllPairs), "all-pairs");
+    }
+
+    #[test]
+    fn the_cost_per_ball_is_taken_against_the_first_size() {
+        let result = |balls: usize, collisions, ms: f64| CaseResult {
+            case: BenchCase {
+                balls,
+                steps: 10,
+                broad_phase: BroadPhase::Grid,
+                collisions,
+            },
+            cores: 1,
+            threads: 1,
+            ms_per_step_median: ms,
+            ns_per_ball_step: ms * 1e6 / balls as f64,
+            contacts_per_step: 0.0,
+            collisions_per_step: 0.0,
+            collisions_per_sim_second: 0.0,
+            collisions_per_cpu_second: 0.0,
+            peak_rss_mib: None,
+        };
+        let row = |balls, discrete_ms, continuous_ms| BenchRow {
+            balls,
+            one_core: result(balls, CollisionMode::Discrete, discrete_ms),
+            all_cores: result(balls, CollisionMode::Discrete, discrete_ms / 1.5),
+            all_pairs: None,
+            continuous_one_core: result(balls, CollisionMode::Continuous, continuous_ms),
+            continuous_all_cores: result(balls, CollisionMode::Continuous, continuous_ms),
+        };
+        // 10x the balls: discrete 13x the time (1.3x a ball), continuous 20x (2x a ball).
+        let rows = [row(100_000, 10.0, 30.0), row(1_000_000, 130.0, 600.0)];
+        let ratios = cost_per_ball_against_first(&rows);
+        assert!((ratios[0].0 - 1.0).abs() < 1e-12 && (ratios[0].1 - 1.0).abs() < 1e-12);
+        assert!((ratios[1].0 - 1.3).abs() < 1e-9, "{:?}", ratios[1]);
+        assert!((ratios[1].1 - 2.0).abs() < 1e-9, "{:?}", ratios[1]);
+        assert!((rows[0].speedup_from_cores() - 1.5).abs() < 1e-12);
+        let table = format_table(&rows);
+        assert!(
+            table.contains("1.30x") && table.contains("2.00x"),
+            "{table}"
+        );
+        assert!(cost_per_ball_against_first(&[]).is_empty());
     }
 }
