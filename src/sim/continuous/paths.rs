@@ -131,18 +131,25 @@ mod tests {
         slots
     }
 
+    /// `circles` in a grid numbered by slot (with the slot order) and every ball on its first
+    /// path.
+    fn first_paths(circles: &[Circle]) -> (UniformGrid, Vec<u32>, Paths) {
+        let mut grid = UniformGrid::default();
+        grid.rebuild(circles);
+        let mut order = Vec::new();
+        grid.renumber_by_slot(&mut order);
+        let mut paths = Paths::default();
+        paths.reset(&grid);
+        (grid, order, paths)
+    }
+
     #[test]
     fn a_redirected_path_is_found_where_it_goes_not_where_it_was() {
         // 20 x 20 balls of radius 2, 10 px apart: the grid's limit for big is 8 px.
         let circles: Vec<Circle> = (0..400)
             .map(|k| Circle::new(DVec2::new((k % 20) as f64, (k / 20) as f64) * 10.0, 2.0))
             .collect();
-        let mut grid = UniformGrid::default();
-        grid.rebuild(&circles);
-        let mut order = Vec::new();
-        grid.renumber_by_slot(&mut order);
-        let mut paths = Paths::default();
-        paths.reset(&grid);
+        let (grid, order, mut paths) = first_paths(&circles);
         let slot_at = |center: DVec2| {
             let index = circles.iter().position(|c| c.center == center).unwrap();
             order.iter().position(|&k| k as usize == index).unwrap() as u32
@@ -179,12 +186,7 @@ mod tests {
     #[test]
     fn a_big_ball_s_path_is_kept_apart_and_found_until_it_is_hit_again() {
         let circles = crate::sim::geometry::grid::mixed_sizes();
-        let mut grid = UniformGrid::default();
-        grid.rebuild(&circles);
-        let mut order = Vec::new();
-        grid.renumber_by_slot(&mut order);
-        let mut paths = Paths::default();
-        paths.reset(&grid);
+        let (grid, order, mut paths) = first_paths(&circles);
         // The ball of radius 200 is big: its slot lies past the cells'.
         let big = order
             .iter()
