@@ -22,6 +22,7 @@
 pub mod impact;
 mod paths;
 pub mod predict;
+mod queue;
 pub mod state;
 pub mod timeline;
 

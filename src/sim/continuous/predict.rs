@@ -9,8 +9,6 @@
 //! straight line: [`approach_time`]. Otherwise (a falling ball and a still one, or one
 //! sliding along a wall) the relative path is a parabola: [`time_to_touch`].
 
-use std::cmp::Reverse;
-
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Party, Prediction, approach_time, swept_circle};
@@ -147,11 +145,7 @@ impl Timeline {
         if let Some((time, wall)) = wall_time(&mover, swept, spec)
             && now + time <= spec.dt
         {
-            queue.push(Reverse(Impact::with_wall(
-                now + time,
-                party(slot, &mover),
-                wall,
-            )));
+            queue.push(Impact::with_wall(now + time, party(slot, &mover), wall));
         }
         self.paths
             .redirect(&self.grid, slot as u32, mover.hits, swept);
@@ -165,11 +159,11 @@ impl Timeline {
             let Some(time) = pair_time(&mover, other_mover, now, spec.dt) else {
                 return;
             };
-            queue.push(Reverse(Impact::between(
+            queue.push(Impact::between(
                 time,
                 party(slot, &mover),
                 party(other_slot, other_mover),
-            )));
+            ));
         };
         // Every ball's current path is known by the circle it sweeps: if two do not touch,
         // neither can the balls.

@@ -2,14 +2,12 @@
 //! `Mover`, and what a step needs of the parameters ([`StepSpec`]). `predict.rs` (stage 2)
 //! and `timeline.rs` (stage 3) each implement their half of `Timeline` on it.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::impact::{Impact, Prediction};
+use super::impact::Prediction;
 use super::paths::Paths;
+use super::queue::ImpactQueue;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
@@ -147,7 +145,7 @@ pub struct Timeline {
     /// Each ball's swept circle by index, to sort into the grid.
     pub(super) swept: Vec<Circle>,
     pub(super) predictions: Vec<Prediction>,
-    pub(super) queue: BinaryHeap<Reverse<Impact>>,
+    pub(super) queue: ImpactQueue,
     /// The pairs that overlapped at the start of the step, by input index, lower first.
     pub(super) overlapping: Vec<(u32, u32)>,
     /// Every ball on this step's timeline, by slot: all a prediction reads of one ball in

@@ -13,8 +13,6 @@
 //! ball that holds still holds still itself until the step ends; two flying balls meeting
 //! that slowly move on together (restitution 0). None of these is a hit.
 
-use std::cmp::Reverse;
-
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Prediction};
@@ -42,7 +40,7 @@ impl Timeline {
         mut on_hit: impl FnMut(Hit),
     ) {
         self.start();
-        while let Some(Reverse(impact)) = self.queue.pop() {
+        while let Some(impact) = self.queue.pop() {
             if !self.is_current(&impact) {
                 continue;
             }
@@ -63,15 +61,19 @@ impl Timeline {
     /// yet; the predictions queued.
     fn start(&mut self) {
         self.paths.reset(&self.grid);
-        self.queue.clear();
+        self.queue.start(
+            self.predictions
+                .iter()
+                .filter_map(|prediction| match *prediction {
+                    Prediction::Impact(impact) => Some(impact),
+                    Prediction::Overlap(..) => None,
+                }),
+        );
         self.overlapping.clear();
         for prediction in &self.predictions {
-            match *prediction {
-                Prediction::Impact(impact) => self.queue.push(Reverse(impact)),
-                Prediction::Overlap(a, b) => {
-                    let (a, b) = (self.order[a as usize], self.order[b as usize]);
-                    self.overlapping.push((a.min(b), a.max(b)));
-                }
+            if let Prediction::Overlap(a, b) = *prediction {
+                let (a, b) = (self.order[a as usize], self.order[b as usize]);
+                self.overlapping.push((a.min(b), a.max(b)));
             }
         }
         self.cut_short = false;
