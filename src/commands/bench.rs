@@ -178,17 +178,22 @@ impl BenchRow {
     pub fn speedup_over_all_pairs(&self) -> Option<f64> {
         self.all_pairs
             .as_ref()
-            .map(|all| all.ms_per_step_median / self.one_core.ms_per_step_median)
+            .map(|all| speedup(all, &self.one_core))
     }
 
     pub fn speedup_from_cores(&self) -> f64 {
-        self.one_core.ms_per_step_median / self.all_cores.ms_per_step_median
+        speedup(&self.one_core, &self.all_cores)
     }
 
     /// The continuous mode's speed-up from all cores.
     pub fn continuous_speedup_from_cores(&self) -> f64 {
-        self.continuous_one_core.ms_per_step_median / self.continuous_all_cores.ms_per_step_median
+        speedup(&self.continuous_one_core, &self.continuous_all_cores)
     }
+}
+
+/// How many times faster `faster` ran a step than `slower`.
+fn speedup(slower: &CaseResult, faster: &CaseResult) -> f64 {
+    slower.ms_per_step_median / faster.ms_per_step_median
 }
 
 /// Each row's cost per ball-step on one core against the first row's, discrete then

@@ -16,6 +16,18 @@ fn arena(width: f64, height: f64) -> SimParams {
     }
 }
 
+/// Asserts that an energy went from `start` to `end` within `tolerance` of `start`, and that
+/// no two balls overlap in `end_state` (beyond 1e-9 of the smaller radius).
+fn assert_kept_with_no_overlap((start, end): (f64, f64), tolerance: f64, end_state: &StateSummary) {
+    let change = (end - start) / start;
+    assert!(change.abs() < tolerance, "relative change {change}");
+    assert!(
+        end_state.max_overlap_rel < 1e-9,
+        "overlap {}",
+        end_state.max_overlap_rel
+    );
+}
+
 /// Pixels per second for `diameters` diameters of a `radius` ball per step.
 fn speed(diameters: f64, radius: f64) -> f64 {
     diameters * 2.0 * radius / DT
@@ -153,14 +165,8 @@ fn standard_gas_after_600_steps(gravity: DVec2) -> (App, StateSummary, StateSumm
 fn standard_gas_keeps_its_energy_to_one_part_in_a_million() {
     let (app, start, end) = standard_gas_after_600_steps(DVec2::ZERO);
     assert_eq!(end.ball_count, 1000);
-    let change = (end.kinetic_energy - start.kinetic_energy) / start.kinetic_energy;
-    assert!(change.abs() < 1e-6, "relative change {change}");
     // And nothing overlaps: the continuous mode never lets a pair interpenetrate.
-    assert!(
-        end.max_overlap_rel < 1e-9,
-        "overlap {}",
-        end.max_overlap_rel
-    );
+    assert_kept_with_no_overlap((start.kinetic_energy, end.kinetic_energy), 1e-6, &end);
     assert!(app.world().resource::<SimStats>().ball_collisions > 50_000);
 }
 
@@ -304,13 +310,8 @@ fn an_elastic_ball_bounces_to_the_same_height_for_100_seconds() {
 #[test]
 fn the_elastic_gas_under_gravity_keeps_its_mechanical_energy() {
     let (app, start, end) = standard_gas_after_600_steps(DVec2::new(0.0, -500.0));
-    let change = (end.mechanical_energy - start.mechanical_energy) / start.mechanical_energy;
-    assert!(change.abs() < 1e-9, "relative change {change}");
-    assert!(
-        end.max_overlap_rel < 1e-9,
-        "overlap {}",
-        end.max_overlap_rel
-    );
+    let energy = (start.mechanical_energy, end.mechanical_energy);
+    assert_kept_with_no_overlap(energy, 1e-9, &end);
     assert_eq!(app.world().resource::<SimStats>().cut_short_steps, 0);
 }
 
@@ -335,13 +336,7 @@ fn a_few_big_balls_among_many_small_ones_never_overlap_and_keep_the_energy() {
     let big_before = big_velocities(&mut app);
     step(&mut app, 120);
     let end = StateSummary::measure(app.world_mut());
-    let change = (end.kinetic_energy - start.kinetic_energy) / start.kinetic_energy;
-    assert!(change.abs() < 1e-9, "relative change {change}");
-    assert!(
-        end.max_overlap_rel < 1e-9,
-        "overlap {}",
-        end.max_overlap_rel
-    );
+    assert_kept_with_no_overlap((start.kinetic_energy, end.kinetic_energy), 1e-9, &end);
     let big_after = big_velocities(&mut app);
     assert_eq!(big_after.len(), 3);
     for (before, after) in big_before.iter().zip(&big_after) {

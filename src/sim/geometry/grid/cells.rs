@@ -3,6 +3,8 @@
 
 use bevy::math::DVec2;
 
+use crate::sim::geometry::circle::Circle;
+
 /// The grid never has more cells than this many per ball, so a few tiny balls in a huge
 /// arena cost little memory; the cells grow instead.
 const MAX_CELLS_PER_BALL: usize = 4;
@@ -47,6 +49,16 @@ impl CellMap {
     pub fn cell_index(&self, point: DVec2) -> usize {
         let (column, row) = self.cell_coordinates(point);
         row * self.columns + column
+    }
+
+    /// `(column, row)` of the first and last cells that `circle`, grown by `reach`, overlaps:
+    /// the cells holding every ball of radius up to `reach` it may touch.
+    pub fn corners_reached(&self, circle: Circle, reach: f64) -> ((usize, usize), (usize, usize)) {
+        let near = DVec2::splat(circle.radius + reach);
+        (
+            self.cell_coordinates(circle.center - near),
+            self.cell_coordinates(circle.center + near),
+        )
     }
 
     /// `(column, row)` of the cell holding `point`, clamped to the grid as

@@ -96,17 +96,15 @@ impl UniformGrid {
         self.small_count = running as usize;
         self.cell_start[cell_count] = running;
         self.sorted_index.resize(circles.len(), 0);
-        let mut big_slot = self.small_count;
         for (index, &cell) in self.cell_of.iter().enumerate().rev() {
             if cell == NO_CELL {
-                big_slot += 1;
                 continue;
             }
             let slot = &mut self.cell_start[cell as usize];
             *slot -= 1;
             self.sorted_index[*slot as usize] = index as u32;
         }
-        if big_slot > self.small_count {
+        if self.small_count < circles.len() {
             let big_balls = self
                 .cell_of
                 .iter()
@@ -136,10 +134,8 @@ impl UniformGrid {
         let big = self.big.get_or_insert_with(Box::default);
         big.rebuild(big_circles);
         let (cells, reach) = (self.cells, self.small_reach);
-        let spans = big_circles.iter().map(|circle| {
-            let near = DVec2::splat(circle.radius + reach);
-            let (_, first) = cells.cell_coordinates(circle.center - near);
-            let (_, last) = cells.cell_coordinates(circle.center + near);
+        let spans = big_circles.iter().map(|&circle| {
+            let ((_, first), (_, last)) = cells.corners_reached(circle, reach);
             first..=last
         });
         self.big_rows.rebuild(cells.rows, spans);
@@ -283,9 +279,7 @@ impl UniformGrid {
         for &k in self.big_rows.in_row(row) {
             let slot = self.small_count + k as usize;
             let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-            let near = DVec2::splat(circle.radius + self.small_reach);
-            let (first, _) = self.cells.cell_coordinates(circle.center - near);
-            let (last, _) = self.cells.cell_coordinates(circle.center + near);
+            let ((first, _), (last, _)) = self.cells.corners_reached(circle, self.small_reach);
             let start = row * self.cells.columns;
             for other in self.slots_of(start + first..start + last + 1) {
                 visit(
