@@ -9,7 +9,7 @@ use bevy::ecs::schedule::SingleThreadedExecutor;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 
-use crate::sim::SimPlugin;
+use crate::sim::{HitReports, SimPlugin};
 
 /// Default fixed step, seconds.
 pub const DEFAULT_DT: f64 = 1.0 / 60.0;
@@ -43,6 +43,12 @@ pub fn headless_app_with_threads(dt: f64, compute_threads: Option<usize>) -> App
     app.update();
     run_on_this_thread(&mut app);
     app
+}
+
+/// For a headless command that reads only the counters: no message or contact point per
+/// hit ([`HitReports`] off).
+pub fn counters_only(app: &mut App) {
+    app.insert_resource(HitReports { enabled: false });
 }
 
 /// This host's choice, not the simulation's: every schedule of the headless app runs its

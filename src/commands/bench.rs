@@ -12,8 +12,8 @@ use std::process::Command;
 
 use serde::{Deserialize, Serialize};
 
-use crate::headless::{DEFAULT_DT, headless_app_with_threads, median, time_steps};
-use crate::sim::{BroadPhase, CollisionMode, ContactPoints, SceneFile, SimStats, Solver};
+use crate::headless::{DEFAULT_DT, counters_only, headless_app_with_threads, median, time_steps};
+use crate::sim::{BroadPhase, CollisionMode, SceneFile, SimStats, Solver};
 
 /// The standard gas, built in so the bench runs from any directory.
 pub const STANDARD_GAS: &str = include_str!("../../assets/scenes/gas.ron");
@@ -70,19 +70,18 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
     // The scene's own copy of the balls is dropped once they are spawned: at a million balls
     // it is 40 MB of the peak.
     scene.build("gas.ron")?.apply(app.world_mut());
+    counters_only(&mut app);
     app.insert_resource(Solver {
         collisions: case.collisions,
         broad_phase: case.broad_phase,
     });
     time_steps(&mut app, WARM_UP_STEPS, |_| {});
-    let collisions_before = app.world().resource::<SimStats>().ball_collisions;
-    let mut contacts = 0usize;
-    let mut step_ms = time_steps(&mut app, case.steps, |app| {
-        contacts += app.world().resource::<ContactPoints>().0.len();
-    });
+    let before = app.world().resource::<SimStats>().clone();
+    let mut step_ms = time_steps(&mut app, case.steps, |_| {});
     let total_ms: f64 = step_ms.iter().sum();
-    let collisions =
-        (app.world().resource::<SimStats>().ball_collisions - collisions_before) as f64;
+    let after = app.world().resource::<SimStats>();
+    let collisions = (after.ball_collisions - before.ball_collisions) as f64;
+    let contacts = (after.contact_points - before.contact_points) as f64;
     let steps = case.steps.max(1) as f64;
     let median = median(&mut step_ms);
     Ok(CaseResult {
@@ -91,7 +90,7 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
         threads,
         ms_per_step_median: median,
         ns_per_ball_step: median * 1e6 / case.balls.max(1) as f64,
-        contacts_per_step: contacts as f64 / steps,
+        contacts_per_step: contacts / steps,
         collisions_per_step: collisions / steps,
         collisions_per_sim_second: collisions / (steps * DEFAULT_DT),
         collisions_per_cpu_second: collisions / (total_ms.max(f64::MIN_POSITIVE) * 1e-3),

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::observe::Observers;
 use super::progress::Progress;
-use crate::headless::{headless_app_with_threads, mean, median, time_steps};
+use crate::headless::{counters_only, headless_app_with_threads, mean, median, time_steps};
 use crate::sim::measure::gas::SpeedHistogram;
 use crate::sim::{SceneSetup, SimClock, SimParams, SimStats, StateSummary};
 
@@ -155,6 +155,7 @@ pub fn run_scene_showing(
     observers: &mut Observers,
 ) -> (App, RunReport) {
     let mut app = headless_app_with_threads(dt, compute_threads);
+    counters_only(&mut app);
     setup.apply(app.world_mut());
     let start = StateSummary::measure(app.world_mut());
     let chunk = if observers.is_empty() {

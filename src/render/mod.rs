@@ -127,6 +127,7 @@ fn give_ball_a_sprite(
         return;
     };
     commands.entity(added.entity).insert((
+        PreviousPosition(position.0),
         Sprite {
             image: texture.0.clone(),
             color: colour_of(view.colour_mode, *id, radius.0, velocity.0),

@@ -67,7 +67,7 @@ pub use intents::{BallCountOutcome, Intent};
 pub use measure::{SimStats, StateSummary};
 pub use messages::{BallCollision, Wall, WallCollision};
 pub use params::{BroadPhase, CollisionMode, MassModel, RunControl, SimParams, Solver};
-pub use report::ContactPoints;
+pub use report::{ContactPoints, HitReports};
 pub use scene::{SceneError, SceneFile, SceneSetup, SimRng};
 pub use spawn::SpawnSettings;
 
@@ -158,6 +158,7 @@ fn add_resources_and_messages(app: &mut App) {
         .init_resource::<ball::BallSnapshot>()
         .init_resource::<report::StepLog>()
         .init_resource::<ContactPoints>()
+        .init_resource::<HitReports>()
         .init_resource::<discrete::detect::Contacts>()
         .init_resource::<discrete::detect::DetectionGrid>()
         .init_resource::<continuous::Timeline>()

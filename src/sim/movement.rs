@@ -32,7 +32,7 @@ type MovingBalls<'w, 's> = Query<
     (
         Entity,
         &'static mut Position,
-        &'static mut PreviousPosition,
+        Option<&'static mut PreviousPosition>,
         &'static mut Velocity,
         &'static Radius,
         &'static Rest,
@@ -99,7 +99,9 @@ pub fn move_and_contain(
     let (snapshot, log) = (&mut *snapshot, &mut *log);
     snapshot.clear();
     for (ball, mut position, mut previous, mut velocity, radius, rest) in &mut balls {
-        previous.0 = position.0;
+        if let Some(previous) = previous.as_mut() {
+            previous.0 = position.0;
+        }
         let held = rest.is_held();
         if !held {
             let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
@@ -141,7 +143,9 @@ pub fn damp_velocities(
     let snapshot = &mut *snapshot;
     snapshot.clear();
     for (ball, position, mut previous, mut velocity, radius, rest) in &mut balls {
-        previous.0 = position.0;
+        if let Some(previous) = previous.as_mut() {
+            previous.0 = position.0;
+        }
         let held = rest.is_held();
         if !held {
             velocity.0 = motion.damped(velocity.0);

@@ -1,6 +1,7 @@
-//! Stage 4, report: what the earlier stages recorded in the [`StepLog`] becomes the outward
-//! [`BallCollision`] and [`WallCollision`] messages, the [`SimStats`] counters and the
-//! overlay's [`ContactPoints`]. The stages themselves write no messages and no counters.
+//! Stage 4, report: what the earlier stages recorded in the [`StepLog`] becomes the
+//! [`SimStats`] counters and, unless [`HitReports`] is off, the outward [`BallCollision`] and
+//! [`WallCollision`] messages and the overlay's [`ContactPoints`]. The stages themselves
+//! write no messages and no counters.
 //!
 //! Runs in [`SimSystems::Report`](super::SimSystems::Report), after the response. In debug
 //! builds the same stage asserts that every position and velocity is finite.
@@ -108,14 +109,32 @@ pub struct StepLog {
     pub resting_wall_impulse: f64,
 }
 
-/// The last step's contact points, for the overlay and the bench.
+/// The last step's contact points, for the overlay.
 #[derive(Resource, Debug, Default)]
 pub struct ContactPoints(pub Vec<ContactPoint>);
 
-/// Turns the step's log into messages, counters and contact points.
+/// Whether the report stage hands every hit on as a [`BallCollision`] or [`WallCollision`]
+/// message and keeps the step's [`ContactPoints`]: on unless turned off. The counters in
+/// [`SimStats`] are kept either way. The headless commands, which read only the counters,
+/// turn it off: at a million balls the messages and points are about 50 MB and a few
+/// milliseconds a step. (Box2D's hit events are likewise asked for, not given by default.)
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HitReports {
+    pub enabled: bool,
+}
+
+impl Default for HitReports {
+    fn default() -> Self {
+        Self { enabled: true }
+    }
+}
+
+/// Turns the step's log into counters and, if [`HitReports`] asks for them, messages and
+/// contact points.
 pub fn report_step(
     clock: Res<SimClock>,
     snapshot: Res<BallSnapshot>,
+    reports: Res<HitReports>,
     mut log: ResMut<StepLog>,
     mut stats: ResMut<SimStats>,
     mut contact_points: ResMut<ContactPoints>,
@@ -124,6 +143,7 @@ pub fn report_step(
 ) {
     let step_start = clock.elapsed;
     let entities = &snapshot.entities;
+    stats.contact_points += log.contacts.len() as u64;
     for hit in log.hits.drain(..) {
         match hit {
             Hit::Ball {
@@ -136,15 +156,17 @@ pub fn report_step(
                 closing_speed,
             } => {
                 stats.ball_collisions += 1;
-                ball_hits.write(BallCollision {
-                    a: entities[a as usize],
-                    b: entities[b as usize],
-                    time: step_start + time,
-                    point,
-                    normal,
-                    impulse,
-                    normal_speed: closing_speed,
-                });
+                if reports.enabled {
+                    ball_hits.write(BallCollision {
+                        a: entities[a as usize],
+                        b: entities[b as usize],
+                        time: step_start + time,
+                        point,
+                        normal,
+                        impulse,
+                        normal_speed: closing_speed,
+                    });
+                }
             }
             Hit::Wall {
                 ball,
@@ -156,14 +178,16 @@ pub fn report_step(
             } => {
                 stats.wall_collisions += 1;
                 stats.wall_impulse += impulse;
-                wall_hits.write(WallCollision {
-                    ball: entities[ball as usize],
-                    wall,
-                    time: step_start + time,
-                    point,
-                    impulse,
-                    normal_speed,
-                });
+                if reports.enabled {
+                    wall_hits.write(WallCollision {
+                        ball: entities[ball as usize],
+                        wall,
+                        time: step_start + time,
+                        point,
+                        impulse,
+                        normal_speed,
+                    });
+                }
             }
         }
     }
@@ -171,8 +195,10 @@ pub fn report_step(
     if std::mem::take(&mut log.cut_short) {
         stats.cut_short_steps += 1;
     }
-    // Hand the buffer over rather than copy it; the log gets the old one back, emptied.
-    std::mem::swap(&mut contact_points.0, &mut log.contacts);
+    if reports.enabled {
+        // Hand the buffer over rather than copy it; the log gets the old one back, emptied.
+        std::mem::swap(&mut contact_points.0, &mut log.contacts);
+    }
     log.contacts.clear();
 }
 

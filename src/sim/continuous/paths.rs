@@ -1,7 +1,8 @@
 //! The rest of each ball's path during a continuous step, as the circle it sweeps until the
-//! step ends, kept by slot (the grid's cell order), so that a ball redirected by an impact
-//! finds every ball whose path may cross its new one by reading the grid's cells around it:
-//! one pass over contiguous memory, whether those balls flew straight or were redirected.
+//! step ends, kept in the grid in place of the ball's first circle, by slot (the grid's cell
+//! order), so that a ball redirected by an impact finds every ball whose path may cross its
+//! new one by reading the grid's cells around it: one pass over contiguous memory, whether
+//! those balls flew straight or were redirected.
 //!
 //! A redirected ball stays in the cell of its first path; its new circle may reach further
 //! from that cell, and [`Paths::reach`] grows to cover it. A path reaching too far (or a big
@@ -13,17 +14,15 @@ use crate::sim::geometry::Circle;
 use crate::sim::geometry::circle::circles_touch;
 use crate::sim::geometry::grid::UniformGrid;
 
-/// Each ball's current path, by slot.
+/// How far each ball's current path reaches, and the paths kept apart. The current paths of
+/// the balls in cells are the grid's circles: each ball's first path's until an impact
+/// redirects it; one that touches nothing while the ball's path is kept in `far`, or once it
+/// takes no more impacts this step ([`end`](Self::end)).
 #[derive(Debug, Default)]
 pub struct Paths {
-    /// By slot, for the balls in the grid's cells: the circle the rest of the ball's path
-    /// sweeps (its first path's, from the grid, until an impact redirects it); one that
-    /// touches nothing while the ball's path is kept in `far`, or once it takes no more
-    /// impacts this step ([`end`](Self::end)).
-    current: Vec<Circle>,
-    /// How far, along either axis, a current circle reaches from its ball's first centre
-    /// (the one that files it in its cell): a query grown by this finds every circle it
-    /// touches. It only grows during a step, at most to `far_limit`.
+    /// How far, along either axis, a current circle reaches from its ball's cell: a query
+    /// grown by this finds every circle it touches. It only grows during a step, at most to
+    /// `far_limit`.
     reach: f64,
     /// A redirected circle reaching further than this goes to `far`.
     far_limit: f64,
@@ -50,34 +49,30 @@ const NOWHERE: Circle = Circle {
 impl Paths {
     /// Every ball on its first path: the circles `grid` holds.
     pub fn reset(&mut self, grid: &UniformGrid) {
-        self.current.clear();
-        self.current
-            .extend_from_slice(&grid.circles_by_slot()[..grid.small_count()]);
         self.reach = grid.small_reach();
         self.far_limit = grid.big_limit();
         self.far.clear();
     }
 
     /// Ball `slot`, which now has `hits` hits, takes a new path that sweeps `swept`.
-    pub fn redirect(&mut self, grid: &UniformGrid, slot: u32, hits: u32, swept: Circle) {
-        let keep_apart = |reach: f64| reach > self.far_limit;
-        if let Some(current) = self.current.get_mut(slot as usize) {
-            let first = grid.circle_in_slot(slot as usize).center;
-            let reach = (swept.center - first).abs().max_element() + swept.radius;
-            if !keep_apart(reach) {
-                *current = swept;
+    pub fn redirect(&mut self, grid: &mut UniformGrid, slot: u32, hits: u32, swept: Circle) {
+        let slot_index = slot as usize;
+        if slot_index < grid.small_count() {
+            let reach = grid.reach_from_cell(slot_index, swept);
+            if reach <= self.far_limit {
+                grid.replace_circle_in_slot(slot_index, swept);
                 self.reach = self.reach.max(reach);
                 return;
             }
-            *current = NOWHERE;
+            grid.replace_circle_in_slot(slot_index, NOWHERE);
         }
         self.far.push(FarPath { slot, hits, swept });
     }
 
     /// Ball `slot` takes no more impacts this step: no path of it is found any more.
-    pub fn end(&mut self, slot: u32) {
-        if let Some(current) = self.current.get_mut(slot as usize) {
-            *current = NOWHERE;
+    pub fn end(&mut self, grid: &mut UniformGrid, slot: u32) {
+        if (slot as usize) < grid.small_count() {
+            grid.replace_circle_in_slot(slot as usize, NOWHERE);
         }
     }
 
@@ -91,10 +86,11 @@ impl Paths {
         mut visit: impl FnMut(u32),
     ) {
         let near = DVec2::splat(swept.radius + self.reach);
+        let current = grid.circles_by_slot();
         grid.for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
             let slots = grid.slots_of(cells);
             let first = slots.start;
-            for (offset, &circle) in self.current[slots].iter().enumerate() {
+            for (offset, &circle) in current[slots].iter().enumerate() {
                 if circles_touch(swept, circle) {
                     visit((first + offset) as u32);
                 }

@@ -34,14 +34,10 @@ impl Timeline {
         spec: StepSpec,
     ) {
         let dt = spec.dt;
-        self.swept.clear();
-        self.swept
-            .extend(circles.iter().zip(velocities).zip(held).map(
-                |((circle, velocity), &still)| {
-                    swept_by(&Mover::new(*circle, *velocity, spec.gravity, still), dt)
-                },
-            ));
-        self.grid.rebuild(&self.swept);
+        self.grid.rebuild_with(circles.len(), |ball| {
+            let mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+            swept_by(&mover, dt)
+        });
         // From here on every ball is known by its slot in the grid's cell order.
         self.grid.renumber_by_slot(&mut self.order);
         self.movers.clear();
@@ -130,7 +126,7 @@ impl Timeline {
         if mover.hits == MAX_HITS_PER_BALL {
             // No more impacts for this ball this step: the end-of-step fallback takes over.
             self.cut_short = true;
-            self.paths.end(slot as u32);
+            self.paths.end(&mut self.grid, slot as u32);
             return;
         }
         let rest = spec.dt - now;
@@ -148,7 +144,7 @@ impl Timeline {
             queue.push(Impact::with_wall(now + time, party(slot, &mover), wall));
         }
         self.paths
-            .redirect(&self.grid, slot as u32, mover.hits, swept);
+            .redirect(&mut self.grid, slot as u32, mover.hits, swept);
         let movers = &self.movers;
         let consider = |other: u32| {
             let other_slot = other as usize;

@@ -142,8 +142,6 @@ pub struct Timeline {
     pub(super) order: Vec<u32>,
     /// The inverse of `order`, when a step needs it (a pile's search around the flying).
     pub(super) slot_of: Vec<u32>,
-    /// Each ball's swept circle by index, to sort into the grid.
-    pub(super) swept: Vec<Circle>,
     pub(super) predictions: Vec<Prediction>,
     pub(super) queue: ImpactQueue,
     /// The pairs that overlapped at the start of the step, by input index, lower first.

@@ -15,6 +15,9 @@ pub struct SimStats {
     /// Continuous steps that reached their hit budget and finished without handling every
     /// impact (see [`MAX_HITS_PER_BALL`](crate::sim::continuous::MAX_HITS_PER_BALL)).
     pub cut_short_steps: u64,
+    /// Contact points recorded (discrete mode: touching pairs found; continuous mode:
+    /// ball–ball impacts), summed over the steps.
+    pub contact_points: u64,
 }
 
 impl SimStats {

@@ -40,6 +40,22 @@ impl CellMap {
         }
     }
 
+    /// The side of a cell.
+    pub fn cell_size(&self) -> f64 {
+        1.0 / self.inverse_cell_size
+    }
+
+    /// How far, along either axis, `point` lies outside cell `cell` (zero inside), with a
+    /// margin against rounding: a box around `point` grown by this reaches the cell.
+    pub fn distance_to_cell(&self, cell: usize, point: DVec2) -> f64 {
+        let size = self.cell_size();
+        let corner = DVec2::new((cell % self.columns) as f64, (cell / self.columns) as f64);
+        let low = self.origin + corner * size;
+        let outside = (low - point).max(point - (low + size)).max(DVec2::ZERO);
+        let margin = 1e-9 * (size + point.abs().max_element() + self.origin.abs().max_element());
+        outside.max_element() + margin
+    }
+
     pub fn cell_count(&self) -> usize {
         self.columns * self.rows
     }

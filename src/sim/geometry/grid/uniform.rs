@@ -56,27 +56,34 @@ fn is_big(radius: f64, big_limit: f64) -> bool {
 impl UniformGrid {
     /// Sorts `circles` into cells, the big ones apart.
     pub fn rebuild(&mut self, circles: &[Circle]) {
-        let radius_sum: f64 = circles.iter().map(|circle| circle.radius).sum();
-        self.big_limit = BIG_RADIUS_FACTOR * radius_sum / circles.len().max(1) as f64;
+        self.rebuild_with(circles.len(), |index| circles[index]);
+    }
+
+    /// [`rebuild`](Self::rebuild) with the `count` circles made by `circle_at(index)` (each
+    /// made a few times), for a caller that would otherwise keep a copy of them only to sort.
+    pub fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle) {
+        let circles = || (0..count).map(&circle_at);
+        let radius_sum: f64 = circles().map(|circle| circle.radius).sum();
+        self.big_limit = BIG_RADIUS_FACTOR * radius_sum / count.max(1) as f64;
         let big_limit = self.big_limit;
         let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
-        for circle in circles {
+        for circle in circles() {
             min = min.min(circle.center);
             max = max.max(circle.center);
             if !is_big(circle.radius, big_limit) {
                 largest_radius = largest_radius.max(circle.radius);
             }
         }
-        if circles.is_empty() {
+        if count == 0 {
             (min, max) = (DVec2::ZERO, DVec2::ZERO);
         }
         self.small_reach = largest_radius;
-        self.cells = CellMap::covering(min, max, largest_radius, circles.len());
+        self.cells = CellMap::covering(min, max, largest_radius, count);
         let cell_count = self.cells.cell_count();
         self.cell_start.clear();
         self.cell_start.resize(cell_count + 1, 0);
         self.cell_of.clear();
-        for circle in circles {
+        for circle in circles() {
             if is_big(circle.radius, big_limit) {
                 self.cell_of.push(NO_CELL);
                 continue;
@@ -95,7 +102,7 @@ impl UniformGrid {
         }
         self.small_count = running as usize;
         self.cell_start[cell_count] = running;
-        self.sorted_index.resize(circles.len(), 0);
+        self.sorted_index.resize(count, 0);
         for (index, &cell) in self.cell_of.iter().enumerate().rev() {
             if cell == NO_CELL {
                 continue;
@@ -104,7 +111,7 @@ impl UniformGrid {
             *slot -= 1;
             self.sorted_index[*slot as usize] = index as u32;
         }
-        if self.small_count < circles.len() {
+        if self.small_count < count {
             let big_balls = self
                 .cell_of
                 .iter()
@@ -120,7 +127,7 @@ impl UniformGrid {
         self.sorted_circle.extend(
             self.sorted_index
                 .iter()
-                .map(|&index| circles[index as usize]),
+                .map(|&index| circle_at(index as usize)),
         );
         self.rebuild_big();
     }
@@ -156,11 +163,34 @@ impl UniformGrid {
         std::mem::swap(order, &mut self.sorted_index);
         self.sorted_index.clear();
         self.sorted_index.extend(0..order.len() as u32);
+        // Each slot's cell, for `reach_from_cell`.
+        self.cell_of.clear();
+        for cell in 0..self.cells.cell_count() {
+            let slots = self.slots_of(cell..cell + 1);
+            self.cell_of.extend(std::iter::repeat_n(cell as u32, slots.len()));
+        }
+        self.cell_of.resize(order.len(), NO_CELL);
     }
 
     /// The circle of the ball in `slot`.
     pub fn circle_in_slot(&self, slot: usize) -> Circle {
         self.sorted_circle[slot]
+    }
+
+    /// Puts `circle` in the place of the ball in `slot`, in its cell (after
+    /// [`renumber_by_slot`](Self::renumber_by_slot), for a ball in the cells): a query grown
+    /// by [`reach_from_cell`](Self::reach_from_cell) finds it. The continuous mode keeps each
+    /// ball's current path so during its timeline.
+    pub fn replace_circle_in_slot(&mut self, slot: usize, circle: Circle) {
+        self.sorted_circle[slot] = circle;
+    }
+
+    /// How far, along either axis, `circle` reaches from the cell of the ball in `slot` (after
+    /// [`renumber_by_slot`](Self::renumber_by_slot), for a ball in the cells): a query around
+    /// a circle grown by this much finds `circle` filed in that cell if the two touch.
+    pub fn reach_from_cell(&self, slot: usize, circle: Circle) -> f64 {
+        let cell = self.cell_of[slot] as usize;
+        circle.radius + self.cells.distance_to_cell(cell, circle.center)
     }
 
     /// Every ball's circle, by slot.
