@@ -96,10 +96,7 @@ impl NextBallId {
 }
 
 /// The components that make `state` a simulated ball with number `id`.
-pub fn ball_bundle(
-    id: BallId,
-    state: BallState,
-) -> (Ball, BallId, Position, Velocity, Radius) {
+pub fn ball_bundle(id: BallId, state: BallState) -> (Ball, BallId, Position, Velocity, Radius) {
     (
         Ball,
         id,

@@ -120,7 +120,7 @@ impl Plugin for SimPlugin {
             .add_systems(
                 SimSchedule,
                 (
-                    (clock::start_step, carry::steer_carried)
+                    (clock::start_step, report::start_log, carry::steer_carried)
                         .chain()
                         .before(Movement),
                     // The pipeline: each stage, the system of each mode.

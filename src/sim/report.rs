@@ -98,15 +98,62 @@ pub struct ContactPoint {
 /// by the report stage.
 #[derive(Resource, Debug, Default)]
 pub struct StepLog {
-    pub hits: Vec<Hit>,
+    pub hits: HitLog,
     /// Discrete mode: every touching pair found; continuous mode: every ball–ball impact.
+    /// Kept only if [`HitReports`] asks for them ([`note_contact`](Self::note_contact)),
+    /// counted always.
     pub contacts: Vec<ContactPoint>,
+    pub contact_count: u64,
+    keep_contacts: bool,
     /// A continuous step stopped handling impacts for some ball (see
     /// [`MAX_HITS_PER_BALL`](super::continuous::MAX_HITS_PER_BALL)).
     pub cut_short: bool,
     /// The walls' impulse on resting balls (stops, the resting solver's contacts, sleeping
     /// balls' weight): no hits, but part of the pressure. Mass x pixels per second.
     pub resting_wall_impulse: f64,
+}
+
+impl StepLog {
+    /// Counts a contact point, and keeps it if this step's [`HitReports`] asks for them.
+    pub fn note_contact(&mut self, contact: ContactPoint) {
+        self.contact_count += 1;
+        if self.keep_contacts {
+            self.contacts.push(contact);
+        }
+    }
+}
+
+/// The step's hits as the stages record them: every one if this step's [`HitReports`] asks
+/// for messages; otherwise the wall hits only (their impulses, summed in order, make the
+/// pressure), the ball hits counted.
+#[derive(Debug, Default)]
+pub struct HitLog {
+    pub kept: Vec<Hit>,
+    /// Ball hits counted but not kept.
+    pub ball_hits_not_kept: u64,
+    keep_ball_hits: bool,
+}
+
+impl HitLog {
+    pub fn push(&mut self, hit: Hit) {
+        if self.keep_ball_hits || matches!(hit, Hit::Wall { .. }) {
+            self.kept.push(hit);
+        } else {
+            self.ball_hits_not_kept += 1;
+        }
+    }
+
+    pub fn extend(&mut self, hits: impl IntoIterator<Item = Hit>) {
+        for hit in hits {
+            self.push(hit);
+        }
+    }
+}
+
+/// Before the stages: what this step's log keeps, as [`HitReports`] says.
+pub fn start_log(reports: Res<HitReports>, mut log: ResMut<StepLog>) {
+    log.hits.keep_ball_hits = reports.enabled;
+    log.keep_contacts = reports.enabled;
 }
 
 /// The last step's contact points, for the overlay.
@@ -143,8 +190,9 @@ pub fn report_step(
 ) {
     let step_start = clock.elapsed;
     let entities = &snapshot.entities;
-    stats.contact_points += log.contacts.len() as u64;
-    for hit in log.hits.drain(..) {
+    stats.contact_points += std::mem::take(&mut log.contact_count);
+    stats.ball_collisions += std::mem::take(&mut log.hits.ball_hits_not_kept);
+    for hit in log.hits.kept.drain(..) {
         match hit {
             Hit::Ball {
                 a,

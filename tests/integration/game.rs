@@ -88,6 +88,20 @@ fn the_game_builds_loads_its_scene_and_steps_without_a_window() {
         .iter(world)
         .count();
     assert_eq!(balls, 40, "every ball of the demo has a sprite");
+    // The drawing's own state: each ball's centre at the start of the step, for drawing
+    // between steps, kept by the movement stage.
+    let previous: Vec<(bevy::math::DVec2, bevy::math::DVec2)> = world
+        .query_filtered::<(&ballpit::sim::PreviousPosition, &Position), With<Ball>>()
+        .iter(world)
+        .map(|(previous, position)| (previous.0, position.0))
+        .collect();
+    assert_eq!(previous.len(), 40, "every ball has a previous position");
+    assert!(
+        previous
+            .iter()
+            .any(|(previous, position)| previous != position),
+        "and it is where the ball was a step ago"
+    );
     let step = world.resource::<Time<Fixed>>().timestep().as_secs_f64();
     assert!((step - 1.0 / 60.0).abs() < 1e-9, "{step}");
     assert!(world.resource::<SimClock>().steps >= 2);

@@ -8,6 +8,7 @@ mod continuous;
 #[cfg(feature = "gui")]
 mod game;
 mod hands;
+mod headless;
 mod house;
 mod observe;
 mod physics;

@@ -76,7 +76,7 @@ pub fn run_timeline(
     let log = &mut *log;
     timeline.run(circles, velocities, (held, stopped), spec, |hit| {
         if let Hit::Ball { point, normal, .. } = hit {
-            log.contacts.push(ContactPoint { point, normal });
+            log.note_contact(ContactPoint { point, normal });
         }
         log.hits.push(hit);
     });

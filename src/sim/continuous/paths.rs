@@ -145,7 +145,7 @@ mod tests {
         let circles: Vec<Circle> = (0..400)
             .map(|k| Circle::new(DVec2::new((k % 20) as f64, (k / 20) as f64) * 10.0, 2.0))
             .collect();
-        let (grid, order, mut paths) = first_paths(&circles);
+        let (mut grid, order, mut paths) = first_paths(&circles);
         let slot_at = |center: DVec2| {
             let index = circles.iter().position(|c| c.center == center).unwrap();
             order.iter().position(|&k| k as usize == index).unwrap() as u32
@@ -161,9 +161,9 @@ mod tests {
             Circle::new(DVec2::new(160.0, 100.0), 3.0),
         );
         hits[near as usize] = 1;
-        paths.redirect(&grid, near, 1, near_path);
+        paths.redirect(&mut grid, near, 1, near_path);
         hits[far as usize] = 1;
-        paths.redirect(&grid, far, 1, far_path);
+        paths.redirect(&mut grid, far, 1, far_path);
         assert_eq!(paths.far.len(), 1);
         // A probe beside the new paths finds them; one at the old place of the far one does not.
         let beside_near = Circle::new(DVec2::new(57.5, 50.0), 1.0);
@@ -175,14 +175,14 @@ mod tests {
         // Another hit makes the far entry stale; a ball taking no more impacts is found nowhere.
         hits[far as usize] = 2;
         assert!(!found(&paths, &grid, beside_far, &hits).contains(&far));
-        paths.end(near);
+        paths.end(&mut grid, near);
         assert!(!found(&paths, &grid, beside_near, &hits).contains(&near));
     }
 
     #[test]
     fn a_big_ball_s_path_is_kept_apart_and_found_until_it_is_hit_again() {
         let circles = crate::sim::geometry::grid::mixed_sizes();
-        let (grid, order, mut paths) = first_paths(&circles);
+        let (mut grid, order, mut paths) = first_paths(&circles);
         // The ball of radius 200 is big: its slot lies past the cells'.
         let big = order
             .iter()
@@ -192,7 +192,7 @@ mod tests {
         let mut hits = vec![0; circles.len()];
         hits[big as usize] = 1;
         let moved = Circle::new(DVec2::new(260.0, 300.0), 205.0);
-        paths.redirect(&grid, big, 1, moved);
+        paths.redirect(&mut grid, big, 1, moved);
         assert_eq!(paths.far.len(), 1);
         let beside = Circle::new(DVec2::new(260.0, 507.0), 3.0);
         assert!(found(&paths, &grid, beside, &hits).contains(&big));
@@ -200,7 +200,7 @@ mod tests {
         let first_only = Circle::new(DVec2::new(210.0, 55.0), 1.0);
         assert!(!found(&paths, &grid, first_only, &hits).contains(&big));
         hits[big as usize] = 2;
-        paths.end(big);
+        paths.end(&mut grid, big);
         assert!(!found(&paths, &grid, beside, &hits).contains(&big));
     }
 }

@@ -20,8 +20,10 @@ pub struct ImpactQueue {
 
 impl ImpactQueue {
     /// Empties the queue and fills it with the step's first predictions.
-    pub fn start(&mut self, impacts: impl Iterator<Item = Impact>) {
+    pub fn start(&mut self, impacts: impl Iterator<Item = Impact> + Clone) {
         self.sorted.clear();
+        // Exactly what is needed: the buffer is kept from step to step.
+        self.sorted.reserve_exact(impacts.clone().count());
         self.sorted.extend(impacts);
         self.sorted.sort_unstable();
         self.next = 0;

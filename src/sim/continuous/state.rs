@@ -134,9 +134,10 @@ impl Mover {
 /// The continuous mode's working state, kept between steps to reuse its buffers.
 #[derive(Resource, Debug, Default)]
 pub struct Timeline {
-    /// Each ball's circle swept over the whole step, sorted into cells. The timeline knows
-    /// every ball by its slot in this cell order, so the balls an impact's neighbourhood
-    /// reads lie close together in memory.
+    /// Each ball's circle swept over the whole step, sorted into cells; during the timeline,
+    /// in each slot the circle of the rest of that ball's current path (`paths.rs`). The
+    /// timeline knows every ball by its slot in this cell order, so the balls an impact's
+    /// neighbourhood reads lie close together in memory.
     pub(super) grid: UniformGrid,
     /// The ball in each slot: `order[slot]` is its index in the arrays the step was given.
     pub(super) order: Vec<u32>,

@@ -40,9 +40,11 @@ pub fn detect_contacts(
         &mut grid.0,
         &mut contacts.0,
     );
-    log.contacts
-        .extend(contacts.0.iter().map(|contact| ContactPoint {
+    for contact in &contacts.0 {
+        let point = ContactPoint {
             point: contact.geometry.point,
             normal: contact.geometry.normal,
-        }));
+        };
+        log.note_contact(point);
+    }
 }

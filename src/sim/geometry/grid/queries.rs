@@ -65,14 +65,19 @@ mod tests {
     use super::*;
     use crate::sim::geometry::grid::mixed_sizes;
 
-    #[test]
-    fn a_circle_query_finds_every_ball_it_touches_inside_across_and_outside_the_grid() {
-        let circles: Vec<Circle> = (0..400)
+    /// 400 balls of radius 1-5 scattered over about 330 x 280 px.
+    fn scattered() -> Vec<Circle> {
+        (0..400)
             .map(|i| {
                 let (x, y) = ((i * 37 % 101) as f64 * 3.3, (i * 61 % 97) as f64 * 2.9);
                 Circle::new(DVec2::new(x, y), 1.0 + (i % 5) as f64)
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn a_circle_query_finds_every_ball_it_touches_inside_across_and_outside_the_grid() {
+        let circles = scattered();
         let mut grid = UniformGrid::default();
         grid.rebuild(&circles);
         // Probes inside, across and wholly outside the grid's extent.
@@ -130,5 +135,47 @@ mod tests {
                 assert!(visited.contains(&(k as u32)), "missed {k}");
             }
         }
+    }
+
+    /// Whether a query around `probe` grown by `reach` reads the cell of `slot`.
+    fn query_reads(grid: &UniformGrid, probe: Circle, reach: f64, slot: usize) -> bool {
+        let near = DVec2::splat(probe.radius + reach);
+        let mut found = false;
+        grid.for_each_cell_run_in_box(probe.center - near, probe.center + near, |cells| {
+            found |= grid.slots_of(cells).contains(&slot);
+        });
+        found
+    }
+
+    #[test]
+    fn a_circle_put_in_a_slot_is_found_by_a_query_grown_by_its_reach_from_the_cell() {
+        let circles = scattered();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        grid.renumber_by_slot(&mut Vec::new());
+        let (mut missed_by_radius_alone, mut cases) = (0, 0);
+        for k in 0..4000_usize {
+            let slot = k * 7 % grid.small_count();
+            let first = grid.circle_in_slot(slot);
+            // Moved up to 30 px, and a probe just touching it from one of 16 directions.
+            let shift = DVec2::new((k % 13) as f64 - 6.0, (k % 11) as f64 - 5.0) * 5.0;
+            let moved = Circle::new(first.center + shift, 0.5 + (k % 7) as f64);
+            let direction = DVec2::from_angle((k % 16) as f64 * std::f64::consts::TAU / 16.0);
+            let probe_radius = 0.5 + (k % 3) as f64;
+            let gap = moved.radius + probe_radius;
+            let probe = Circle::new(moved.center + direction * gap * 0.999, probe_radius);
+            let reach = grid.reach_from_cell(slot, moved);
+            assert!(
+                query_reads(&grid, probe, reach, slot),
+                "case {k}: {moved:?}"
+            );
+            missed_by_radius_alone += usize::from(!query_reads(&grid, probe, moved.radius, slot));
+            cases += 1;
+        }
+        // The distance from the cell matters: without it many would be missed.
+        assert!(
+            missed_by_radius_alone > cases / 10,
+            "{missed_by_radius_alone} of {cases}"
+        );
     }
 }

@@ -167,7 +167,8 @@ impl UniformGrid {
         self.cell_of.clear();
         for cell in 0..self.cells.cell_count() {
             let slots = self.slots_of(cell..cell + 1);
-            self.cell_of.extend(std::iter::repeat_n(cell as u32, slots.len()));
+            self.cell_of
+                .extend(std::iter::repeat_n(cell as u32, slots.len()));
         }
         self.cell_of.resize(order.len(), NO_CELL);
     }

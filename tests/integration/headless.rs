@@ -1,0 +1,85 @@
+//! What a headless run keeps: only what its reader asks for. Per-hit messages and contact
+//! points are asked for ([`HitReports`]); the counters come either way, the same to the bit.
+//! The drawing's state between steps is the render plugin's.
+
+use ballpit::prelude::*;
+use ballpit::sim::{ContactPoints, HitReports, PreviousPosition};
+use bevy::prelude::*;
+
+use crate::common::*;
+
+/// The standard gas of `balls` balls and the pile, in `mode`, with hit reports on or off.
+fn run_with_reports(scene: &str, mode: CollisionMode, reports: bool, steps: usize) -> App {
+    let mut file = shipped_scene(scene);
+    if let Some(generate) = file.generate.as_mut() {
+        generate.count = generate.count.min(400);
+    }
+    let mut setup = file.build(scene).unwrap();
+    setup.collisions = Some(mode);
+    let mut app = headless_app(DT);
+    record_collisions(&mut app);
+    app.insert_resource(HitReports { enabled: reports });
+    setup.apply(app.world_mut());
+    step(&mut app, steps);
+    app
+}
+
+#[test]
+fn without_hit_reports_the_counters_and_the_balls_are_the_same_and_nothing_is_sent() {
+    for scene in ["gas.ron", "pile.ron"] {
+        for mode in [CollisionMode::Continuous, CollisionMode::Discrete] {
+            let mut on = run_with_reports(scene, mode, true, 120);
+            let mut off = run_with_reports(scene, mode, false, 120);
+            let (stats_on, stats_off) = (
+                on.world().resource::<SimStats>().clone(),
+                off.world().resource::<SimStats>().clone(),
+            );
+            assert_eq!(stats_on, stats_off, "{scene} {mode:?}");
+            assert!(
+                stats_on.ball_collisions > 100,
+                "{scene} {mode:?}: {stats_on:?}"
+            );
+            assert!(
+                stats_on.contact_points > 0,
+                "{scene} {mode:?}: {stats_on:?}"
+            );
+            assert_eq!(states(&mut on), states(&mut off), "{scene} {mode:?}");
+            // With reports, a message for every hit counted; without, none, and no points.
+            let (recorded_on, recorded_off) = (
+                on.world().resource::<Recorded>(),
+                off.world().resource::<Recorded>(),
+            );
+            assert_eq!(recorded_on.ball_hits.len() as u64, stats_on.ball_collisions);
+            assert_eq!(recorded_on.wall_hits.len() as u64, stats_on.wall_collisions);
+            assert!(recorded_off.ball_hits.is_empty() && recorded_off.wall_hits.is_empty());
+            assert!(off.world().resource::<ContactPoints>().0.is_empty());
+        }
+    }
+}
+
+#[test]
+fn a_headless_ball_has_no_drawing_state_and_one_given_it_follows_the_steps() {
+    let mut app = app_with(
+        SimParams::default(),
+        &[
+            ball(0.0, 0.0, 120.0, 0.0, 10.0),
+            ball(200.0, 0.0, 0.0, 0.0, 10.0),
+        ],
+    );
+    let world = app.world_mut();
+    let drawn = world.query::<&PreviousPosition>().iter(world).count();
+    assert_eq!(drawn, 0, "headless balls carry no previous position");
+    let first = entity_of(&mut app, 0);
+    app.world_mut()
+        .entity_mut(first)
+        .insert(PreviousPosition(bevy::math::DVec2::ZERO));
+    step(&mut app, 3);
+    let position = app.world().get::<Position>(first).unwrap().0;
+    let previous = app.world().get::<PreviousPosition>(first).unwrap().0;
+    // One step of 120 px/s behind (the fixed step is 1/60 s to a few parts in 10^8).
+    assert!(
+        (position.x - previous.x - 2.0).abs() < 1e-6,
+        "{previous} -> {position}"
+    );
+    assert!(previous.x > 3.0, "it moved with the steps: {previous}");
+}
