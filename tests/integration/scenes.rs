@@ -71,6 +71,42 @@ fn the_standard_gas_matches_its_definition() {
 }
 
 #[test]
+fn generated_balls_are_numbered_in_space_order_after_the_hand_placed_ones() {
+    let setup = shipped_scene("mixed.ron").build("mixed.ron").unwrap();
+    // The three hand-placed big balls first, as written.
+    let big: Vec<f64> = setup.balls[..3].iter().map(|b| b.position.x).collect();
+    assert_eq!(big, [-150.0, 150.0, 0.0]);
+    assert!(setup.balls[3..].iter().all(|b| b.radius <= 3.5));
+    // Then the drawn ones, each near the one numbered before it: row by row of cells (here
+    // 80 px, the big balls' diameter), so consecutive balls lie about a cell apart, not half
+    // an arena (as drawn, they would).
+    let drawn = &setup.balls[3..];
+    let mean = |pairs: &mut dyn Iterator<Item = f64>| {
+        let (sum, count) = pairs.fold((0.0, 0), |(s, n), d| (s + d, n + 1));
+        sum / count as f64
+    };
+    let consecutive = mean(
+        &mut drawn
+            .windows(2)
+            .map(|w| w[0].position.distance(w[1].position)),
+    );
+    let half_apart = mean(&mut (0..drawn.len() / 2).map(|k| {
+        drawn[k]
+            .position
+            .distance(drawn[k + drawn.len() / 2].position)
+    }));
+    assert!(
+        consecutive < half_apart / 5.0,
+        "{consecutive} vs {half_apart}"
+    );
+    // And up the arena overall: the first tenth lies below the last tenth.
+    let tenth = drawn.len() / 10;
+    let mean_y =
+        |balls: &[BallState]| balls.iter().map(|b| b.position.y).sum::<f64>() / balls.len() as f64;
+    assert!(mean_y(&drawn[..tenth]) < mean_y(&drawn[drawn.len() - tenth..]));
+}
+
+#[test]
 fn head_on_scene_is_the_worked_example() {
     let (mut app, _) = run_scene(
         &shipped_scene("head_on.ron").build("head_on").unwrap(),

@@ -199,7 +199,7 @@ fn place_balls(
         ));
     }
     let largest_radius = radii(&hand_placed, &drawn).fold(0.0, f64::max);
-    let total = hand_placed.len() + drawn.len();
+    let (hand_placed_count, total) = (hand_placed.len(), hand_placed.len() + drawn.len());
     let mut grid = PlacementGrid::new(half, largest_radius, total);
     let mut balls = Vec::with_capacity(total);
     for (index, ball) in hand_placed.into_iter().enumerate() {
@@ -242,6 +242,11 @@ fn place_balls(
             radius: ball.radius,
         });
     }
+    // Number the generated balls in space order (row by row of the placement grid's cells,
+    // in the order drawn within a cell), so that the balls near each other are near each
+    // other in every per-ball array: at a million balls that is a fifth of a discrete step.
+    // The draws are as before, so the balls are the same, only their numbers differ.
+    balls[hand_placed_count..].sort_by_key(|ball| grid.cell_index(ball.position));
     Ok(balls)
 }
 
