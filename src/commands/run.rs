@@ -121,7 +121,8 @@ fn histogram_rows(histogram: &SpeedHistogram) -> String {
 }
 
 /// Loads `setup` into a fresh headless app and runs `steps` fixed steps of `dt` seconds,
-/// timing each. Returns the app (for dumps and further checks) and the report.
+/// timing each. Returns the app (for dumps and further checks) and the report. The app keeps
+/// the counters only: no collision messages or contact points ([`counters_only`]).
 pub fn run_scene(setup: &SceneSetup, steps: u64, dt: f64) -> (App, RunReport) {
     run_scene_with_threads(setup, steps, dt, None)
 }

@@ -14,13 +14,14 @@
 //! | [`SimSystems::Collision`] | [`detect_contacts`](discrete::detect::detect_contacts): grid, AABB, distance → [`Contacts`](discrete::detect::Contacts) | [`predict_impacts`](continuous::predict_impacts): every time of impact within the step |
 //! | [`SimSystems::Response`] | [`resolve_contacts`](discrete::resolve::resolve_contacts): exchange, separation, walls | [`run_timeline`](continuous::run_timeline): the impacts in time order |
 //! | [`SimSystems::Resting`] | [`rest_and_sleep`](resting::rest_and_sleep): the resting solver, who rests next step, sleep | the same |
-//! | [`SimSystems::Report`] | [`report_step`](report::report_step): messages, counters, contact points | the same |
-//! | around the stages | the clock's `start_step` and [`steer_carried`](carry::steer_carried) (the player's hand) before, `take_pending_step` and `end_step` in `Report`; a finiteness assertion in debug builds | the same |
+//! | [`SimSystems::Report`] | [`report_step`](report::report_step): counters; messages and contact points unless [`HitReports`] is off | the same |
+//! | around the stages | the clock's `start_step`, [`start_log`](report::start_log) (what the step's log keeps) and [`steer_carried`](carry::steer_carried) (the player's hand) before, `take_pending_step` and `end_step` in `Report`; a finiteness assertion in debug builds | the same |
 //!
 //! **Data flows one way**: components → [`BallSnapshot`](ball::BallSnapshot) (movement) →
 //! contacts or predicted impacts (collision) → components (response), each stage recording
 //! what happened in the [`StepLog`](report::StepLog); the report stage turns that into the
-//! outward [`BallCollision`] / [`WallCollision`] messages and the [`SimStats`] counters. Every
+//! [`SimStats`] counters and, unless [`HitReports`] is off, the outward [`BallCollision`] /
+//! [`WallCollision`] messages. Every
 //! stage that needs the step's `dt` or the simulated time reads it from the [`SimClock`].
 //!
 //! **Where things live**: [`geometry`] the pure maths (circles, walls, impulses, the grid);

@@ -100,11 +100,11 @@ pub struct ContactPoint {
 pub struct StepLog {
     pub hits: HitLog,
     /// Discrete mode: every touching pair found; continuous mode: every ball–ball impact.
-    /// Kept only if [`HitReports`] asks for them ([`note_contact`](Self::note_contact)),
-    /// counted always.
+    /// Kept unless [`HitReports`] is off ([`note_contact`](Self::note_contact)).
     pub contacts: Vec<ContactPoint>,
+    /// The contact points noted this step, kept or not.
     pub contact_count: u64,
-    keep_contacts: bool,
+    drop_contacts: bool,
     /// A continuous step stopped handling impacts for some ball (see
     /// [`MAX_HITS_PER_BALL`](super::continuous::MAX_HITS_PER_BALL)).
     pub cut_short: bool,
@@ -117,7 +117,7 @@ impl StepLog {
     /// Counts a contact point, and keeps it if this step's [`HitReports`] asks for them.
     pub fn note_contact(&mut self, contact: ContactPoint) {
         self.contact_count += 1;
-        if self.keep_contacts {
+        if !self.drop_contacts {
             self.contacts.push(contact);
         }
     }
@@ -128,21 +128,24 @@ impl StepLog {
 /// pressure), the ball hits counted.
 #[derive(Debug, Default)]
 pub struct HitLog {
+    /// The hits kept, in the order recorded.
     pub kept: Vec<Hit>,
     /// Ball hits counted but not kept.
     pub ball_hits_not_kept: u64,
-    keep_ball_hits: bool,
+    drop_ball_hits: bool,
 }
 
 impl HitLog {
+    /// Records `hit`: kept, or only counted if it is a ball hit this step drops.
     pub fn push(&mut self, hit: Hit) {
-        if self.keep_ball_hits || matches!(hit, Hit::Wall { .. }) {
+        if !self.drop_ball_hits || matches!(hit, Hit::Wall { .. }) {
             self.kept.push(hit);
         } else {
             self.ball_hits_not_kept += 1;
         }
     }
 
+    /// Records each of `hits` as [`push`](Self::push) does.
     pub fn extend(&mut self, hits: impl IntoIterator<Item = Hit>) {
         for hit in hits {
             self.push(hit);
@@ -152,8 +155,8 @@ impl HitLog {
 
 /// Before the stages: what this step's log keeps, as [`HitReports`] says.
 pub fn start_log(reports: Res<HitReports>, mut log: ResMut<StepLog>) {
-    log.hits.keep_ball_hits = reports.enabled;
-    log.keep_contacts = reports.enabled;
+    log.hits.drop_ball_hits = !reports.enabled;
+    log.drop_contacts = !reports.enabled;
 }
 
 /// The last step's contact points, for the overlay.
@@ -246,6 +249,8 @@ pub fn report_step(
     if reports.enabled {
         // Hand the buffer over rather than copy it; the log gets the old one back, emptied.
         std::mem::swap(&mut contact_points.0, &mut log.contacts);
+    } else {
+        contact_points.0.clear();
     }
     log.contacts.clear();
 }

@@ -46,12 +46,7 @@ impl Timeline {
             Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball])
         }));
         self.predictions.clear();
-        let flying = self.movers.iter().filter(|mover| !mover.still).count();
-        if flying * FEW_FLYING < self.movers.len() {
-            self.predict_around_the_flying(dt);
-        } else {
-            self.predict_every_pair(dt);
-        }
+        // The walls first: the pair search then grows the buffer by exactly what it finds.
         for ((slot, mover), &index) in self.movers.iter().enumerate().zip(&self.order) {
             let swept = self.grid.circle_in_slot(slot);
             if let Some((time, wall)) = wall_time(mover, swept, spec)
@@ -65,6 +60,12 @@ impl Timeline {
                 let impact = Impact::with_wall(time, ball, wall);
                 self.predictions.push(Prediction::Impact(impact));
             }
+        }
+        let flying = self.movers.iter().filter(|mover| !mover.still).count();
+        if flying * FEW_FLYING < self.movers.len() {
+            self.predict_around_the_flying(dt);
+        } else {
+            self.predict_every_pair(dt);
         }
     }
 

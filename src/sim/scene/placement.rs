@@ -66,15 +66,9 @@ impl PlacementGrid {
         None
     }
 
-    /// The cell holding `point`, numbered row by row: an order in which nearby points come
-    /// close together.
-    pub fn cell_index(&self, point: DVec2) -> usize {
-        let (column, row) = self.cell_of(point);
-        row * self.columns + column
-    }
-
     pub fn insert(&mut self, circle: Circle) {
-        let cell = self.cell_index(circle.center);
+        let (column, row) = self.cell_of(circle.center);
+        let cell = row * self.columns + column;
         self.next.push(self.head[cell]);
         self.head[cell] = self.circles.len() as u32;
         self.circles.push(circle);
