@@ -269,8 +269,7 @@ impl SceneSetup {
         world.spawn_batch(
             space_order(&self.balls)
                 .into_iter()
-                .map(|index| ball_bundle(BallId(index as u32), self.balls[index]))
-                .collect::<Vec<_>>(),
+                .map(|index| ball_bundle(BallId(index), self.balls[index as usize])),
         );
         world.insert_resource(NextBallId(self.balls.len() as u32));
     }
@@ -280,7 +279,7 @@ impl SceneSetup {
 /// the scene's order within a cell. Balls near each other then lie near each other in every
 /// per-ball array (the ECS tables, and the stages' snapshots that follow them): at a million
 /// balls, a fifth of a discrete step. Each ball's id stays its place in the scene.
-fn space_order(balls: &[BallState]) -> Vec<usize> {
+fn space_order(balls: &[BallState]) -> Vec<u32> {
     let (min, max) = balls
         .iter()
         .fold((DVec2::MAX, DVec2::MIN), |(min, max), ball| {
@@ -296,7 +295,8 @@ fn space_order(balls: &[BallState]) -> Vec<usize> {
             .saturating_mul(columns)
             .saturating_add(place.x as u64)
     };
-    let mut order: Vec<usize> = (0..balls.len()).collect();
-    order.sort_by_key(|&index| cell_of(&balls[index]));
+    // Scene files hold at most `MAX_BALLS` balls, so an index fits a `u32` (half the memory).
+    let mut order: Vec<u32> = (0..balls.len() as u32).collect();
+    order.sort_by_key(|&index| cell_of(&balls[index as usize]));
     order
 }
