@@ -47,17 +47,12 @@ impl Timeline {
         }));
         self.predictions.clear();
         // The walls first: the pair search then grows the buffer by exactly what it finds.
-        for ((slot, mover), &index) in self.movers.iter().enumerate().zip(&self.order) {
+        for (slot, mover) in self.movers.iter().enumerate() {
             let swept = self.grid.circle_in_slot(slot);
             if let Some((time, wall)) = wall_time(mover, swept, spec)
                 && time <= dt
             {
-                let ball = Party {
-                    slot,
-                    index,
-                    hits: 0,
-                };
-                let impact = Impact::with_wall(time, ball, wall);
+                let impact = Impact::with_wall(time, Party::new(slot, &self.order, 0), wall);
                 self.predictions.push(Prediction::Impact(impact));
             }
         }
@@ -91,7 +86,7 @@ impl Timeline {
     /// overlaps of two still balls, which the timeline leaves to the resting stage.
     fn predict_around_the_flying(&mut self, dt: f64) {
         // The flying balls in the order of the step's input, not by slot: the overlaps found
-        // here are pushed apart in the order found, and a pile settles by that order.
+        // here are pushed apart in the order found, as before the timeline knew slots.
         self.slot_of.clear();
         self.slot_of.resize(self.order.len(), 0);
         for (slot, &index) in self.order.iter().enumerate() {
@@ -134,11 +129,7 @@ impl Timeline {
         let mut swept = swept_by(&mover, rest);
         swept.radius += SWEPT_MARGIN;
         let (queue, order) = (&mut self.queue, &self.order);
-        let party = |slot: usize, mover: &Mover| Party {
-            slot,
-            index: order[slot],
-            hits: mover.hits,
-        };
+        let party = |slot: usize, mover: &Mover| Party::new(slot, order, mover.hits);
         if let Some((time, wall)) = wall_time(&mover, swept, spec)
             && now + time <= spec.dt
         {
@@ -242,11 +233,7 @@ fn predict_pair(
         found.push(Prediction::Overlap(a, b));
     }
     if let Some(time) = pair_time(mover_a, mover_b, 0.0, dt) {
-        let party = |slot: u32| Party {
-            slot: slot as usize,
-            index: order[slot as usize],
-            hits: 0,
-        };
+        let party = |slot: u32| Party::new(slot as usize, order, 0);
         let impact = Impact::between(time, party(a), party(b));
         found.push(Prediction::Impact(impact));
     }
