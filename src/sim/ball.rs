@@ -107,8 +107,8 @@ pub fn ball_bundle(id: BallId, state: BallState) -> (Ball, BallId, Position, Vel
 }
 
 /// Every ball after this step's movement, in query order, in contiguous arrays. The movement
-/// stage writes it as it moves the balls, the collision stage searches it and the response
-/// works on it by index before writing the balls it changed back to their components.
+/// stage copies the balls into it and moves them there, the collision stage searches it and
+/// the response works on it by index before writing every ball back to its components.
 #[derive(Resource, Debug, Default)]
 pub struct BallSnapshot {
     pub entities: Vec<Entity>,
@@ -135,14 +135,6 @@ impl BallSnapshot {
     /// Whether every ball is held still: the mode's stages then have nothing to do.
     pub fn all_held(&self) -> bool {
         self.held.iter().all(|&held| held)
-    }
-
-    pub fn push(&mut self, entity: Entity, circle: Circle, velocity: DVec2, held: bool) {
-        self.entities.push(entity);
-        self.circles.push(circle);
-        self.velocities.push(velocity);
-        self.held.push(held);
-        self.stopped.push(false);
     }
 }
 

@@ -45,6 +45,7 @@ pub mod intents;
 pub mod measure;
 pub mod messages;
 pub mod movement;
+pub mod parallel;
 pub mod params;
 #[cfg(test)]
 mod properties;

@@ -1,6 +1,7 @@
-//! Stage 1, movement: integrate every ball's velocity over the step and copy the balls into
-//! the contiguous [`BallSnapshot`] the later stages work on; remember where each ball was, for
-//! drawing between steps. One system per mode, one pass over the balls each:
+//! Stage 1, movement: copy the balls into the contiguous [`BallSnapshot`] the later stages
+//! work on, remembering where each ball was, for drawing between steps; then integrate every
+//! ball's velocity over the step there (the response writes the balls back). One system per
+//! mode:
 //!
 //! - discrete ([`move_and_contain`]): velocity and position (semi-implicit Euler), then the
 //!   walls: a ball past a wall is mirrored back inside and bounced;
@@ -12,6 +13,8 @@
 //! resting stage moves the resting ones, nothing the sleeping ones. A ball meeting a wall
 //! slower than the resting speed stops against it instead of bouncing.
 //!
+//! The discrete mode's pass runs in pieces on the compute pool for many balls ([`parallel`](super::parallel)).
+//!
 //! Runs in [`SimSystems::Movement`](super::SimSystems::Movement).
 
 use bevy::math::DVec2;
@@ -21,24 +24,29 @@ use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Rest, 
 use super::clock::SimClock;
 use super::geometry::Circle;
 use super::geometry::wall::contain_at_rest;
+use super::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 use super::params::SimParams;
 use super::report::{Hit, StepLog};
 use super::resting::rest_speed;
 
-/// The balls as the movement stage sees them.
+/// The balls as the movement stage reads them: it moves the snapshot, and the response
+/// writes the balls back.
 type MovingBalls<'w, 's> = Query<
     'w,
     's,
     (
         Entity,
-        &'static mut Position,
-        Option<&'static mut PreviousPosition>,
-        &'static mut Velocity,
+        &'static Position,
+        &'static Velocity,
         &'static Radius,
         &'static Rest,
     ),
     With<Ball>,
 >;
+
+/// Where the drawn balls were (the headless balls have no `PreviousPosition`).
+type DrawnBalls<'w, 's> =
+    Query<'w, 's, (&'static Position, &'static mut PreviousPosition), With<Ball>>;
 
 /// One step's motion, with the constants worked out once per step, not once per ball.
 ///
@@ -84,74 +92,119 @@ impl Motion {
     }
 }
 
-/// Discrete mode: moves every ball over the step and contains it in the arena, recording its
-/// wall hits; fills the snapshot.
+/// Discrete mode: moves every ball over the step and contains it in the arena, in the
+/// snapshot, recording its wall hits. The balls are written back by the response.
 pub fn move_and_contain(
     clock: Res<SimClock>,
     params: Res<SimParams>,
-    mut balls: MovingBalls,
+    balls: MovingBalls,
+    drawn: DrawnBalls,
     mut snapshot: ResMut<BallSnapshot>,
     mut log: ResMut<StepLog>,
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
-    let half = params.half_extents();
+    let (half, restitution) = (params.half_extents(), params.restitution);
     let rest_speed = rest_speed(&params, clock.dt);
-    let (snapshot, log) = (&mut *snapshot, &mut *log);
-    snapshot.clear();
-    for (ball, mut position, mut previous, mut velocity, radius, rest) in &mut balls {
-        if let Some(previous) = previous.as_mut() {
-            previous.0 = position.0;
-        }
-        let held = rest.is_held();
-        if !held {
-            let (moved, new_velocity) = motion.integrate(position.0, velocity.0);
+    let snapshot = &mut *snapshot;
+    fill_snapshot(&balls, drawn, snapshot);
+    let BallSnapshot {
+        circles,
+        velocities,
+        held,
+        ..
+    } = snapshot;
+    let parallel = worth_splitting(circles.len());
+    let pieces = circles
+        .chunks_mut(BALLS_PER_PIECE)
+        .zip(velocities.chunks_mut(BALLS_PER_PIECE))
+        .zip(held.chunks(BALLS_PER_PIECE));
+    let contained_by_piece = in_pieces(pieces.enumerate(), parallel, |(piece, balls)| {
+        let ((circles, velocities), held) = balls;
+        let first = (piece * BALLS_PER_PIECE) as u32;
+        let mut at_walls = Vec::new();
+        for (offset, ((circle, velocity), &held)) in
+            circles.iter_mut().zip(velocities.iter_mut()).zip(held).enumerate()
+        {
+            if held {
+                continue;
+            }
+            let (moved, new_velocity) = motion.integrate(circle.center, *velocity);
             let contained = contain_at_rest(
                 moved,
                 new_velocity,
-                radius.0,
+                circle.radius,
                 half,
-                params.restitution,
+                restitution,
                 rest_speed,
             );
-            (position.0, velocity.0) = (contained.position, contained.velocity);
+            (circle.center, *velocity) = (contained.position, contained.velocity);
             if contained.hits != [None, None] {
-                let mass = params.mass_model.mass(radius.0);
-                log.resting_wall_impulse += contained.resting_impulse(mass);
-                log.hits.extend(Hit::walls_of(
-                    snapshot.entities.len() as u32,
-                    &contained,
-                    motion.dt,
-                    half,
-                    params.restitution,
-                    mass,
-                ));
+                at_walls.push((first + offset as u32, contained, circle.radius));
             }
         }
-        snapshot.push(ball, Circle::new(position.0, radius.0), velocity.0, held);
+        at_walls
+    });
+    // The walls' hits and resting impulses in the balls' order, as if found one by one.
+    for (index, contained, radius) in contained_by_piece.into_iter().flatten() {
+        let mass = params.mass_model.mass(radius);
+        log.resting_wall_impulse += contained.resting_impulse(mass);
+        log.hits.extend(Hit::walls_of(
+            index,
+            &contained,
+            motion.dt,
+            half,
+            restitution,
+            mass,
+        ));
     }
 }
 
-/// Continuous mode: damps every ball's velocity (the timeline flies the balls along their
-/// parabolas, impact by impact); fills the snapshot.
+/// Continuous mode: damps every ball's velocity in the snapshot (the timeline flies the balls
+/// along their parabolas, impact by impact, and writes them back).
 pub fn damp_velocities(
     clock: Res<SimClock>,
     params: Res<SimParams>,
-    mut balls: MovingBalls,
+    balls: MovingBalls,
+    drawn: DrawnBalls,
     mut snapshot: ResMut<BallSnapshot>,
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
     let snapshot = &mut *snapshot;
-    snapshot.clear();
-    for (ball, position, mut previous, mut velocity, radius, rest) in &mut balls {
-        if let Some(previous) = previous.as_mut() {
-            previous.0 = position.0;
-        }
-        let held = rest.is_held();
+    fill_snapshot(&balls, drawn, snapshot);
+    for (velocity, &held) in snapshot.velocities.iter_mut().zip(&snapshot.held) {
         if !held {
-            velocity.0 = motion.damped(velocity.0);
+            *velocity = motion.damped(*velocity);
         }
-        snapshot.push(ball, Circle::new(position.0, radius.0), velocity.0, held);
     }
+}
+
+/// Copies every ball into the snapshot, in query order, one array at a time; remembers where
+/// each drawn ball was, for drawing between steps.
+fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut BallSnapshot) {
+    for (position, mut previous) in &mut drawn {
+        previous.0 = position.0;
+    }
+    let BallSnapshot {
+        entities,
+        circles,
+        velocities,
+        held,
+        stopped,
+    } = snapshot;
+    entities.clear();
+    entities.extend(balls.iter().map(|(ball, ..)| ball));
+    circles.clear();
+    circles.extend(
+        balls
+            .iter()
+            .map(|(_, position, _, radius, _)| Circle::new(position.0, radius.0)),
+    );
+    velocities.clear();
+    velocities.extend(balls.iter().map(|(_, _, velocity, ..)| velocity.0));
+    held.clear();
+    held.extend(balls.iter().map(|(.., rest)| rest.is_held()));
+    stopped.clear();
+    stopped.resize(entities.len(), false);
 }
 
 #[cfg(test)]

@@ -4,8 +4,9 @@
 //!
 //! Runs in [`SimSystems::Response`](crate::sim::SimSystems::Response) in discrete mode,
 //! reading [`Contacts`] in their stable order (Gauss–Seidel: each contact sees the velocities
-//! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then writes the
-//! balls that changed back to their components in one pass. Records each exchange and wall
+//! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then writes
+//! every ball (the movement stage moved them in the snapshot) back to its components in one
+//! pass. Records each exchange and wall
 //! hit in the [`StepLog`]. The resting rule applies to pairs and walls alike (see
 //! [`resolve_overlaps`]); pairs of resting balls are the resting stage's.
 
@@ -29,8 +30,8 @@ pub fn resolve_contacts(
     mut log: ResMut<StepLog>,
     mut in_contact: Local<Vec<bool>>,
 ) {
-    if contacts.0.is_empty() {
-        return;
+    if snapshot.all_held() {
+        return; // nothing moved, and nothing touches
     }
     // Discrete mode sees a hit only at the end of the step, as an overlap.
     let step_end = clock.dt;
@@ -63,11 +64,10 @@ pub fn resolve_contacts(
         |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange)),
     );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
-    // the movement stage kept every ball inside, so only they need the walls again, and only
-    // they are written back.
+    // the movement stage kept every ball inside, so only they need the walls again.
     let half = params.half_extents();
     let resting_wall_impulse = &mut log.resting_wall_impulse;
-    let mut settle = |index: usize| {
+    for (index, _) in in_contact.iter().enumerate().filter(|(_, touched)| **touched) {
         let circle = circles[index];
         let contained = contain_at_rest(
             circle.center,
@@ -89,11 +89,10 @@ pub fn resolve_contacts(
                 mass,
             ));
         }
-        // The resting stage reads the snapshot after this stage.
         (circles[index].center, velocities[index]) = (contained.position, contained.velocity);
-        (contained.position, contained.velocity)
-    };
+    }
+    // Every ball: the movement stage moved them in the snapshot only.
     write_back(entities, &mut balls, |index| {
-        in_contact[index].then(|| settle(index))
+        Some((circles[index].center, velocities[index]))
     });
 }

@@ -4,10 +4,9 @@
 
 use std::ops::Range;
 
-use bevy::tasks::{ComputeTaskPool, TaskPool};
-
 use super::circle::{Circle, ContactGeometry, circle_contact, circles_touch};
 use super::grid::{UniformGrid, for_each_pair};
+use crate::sim::parallel::{PARALLEL_MIN_BALLS, compute_pool};
 use crate::sim::params::BroadPhase;
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
@@ -18,8 +17,6 @@ pub struct IndexedContact {
     pub geometry: ContactGeometry,
 }
 
-/// Below this many balls the grid search runs on one thread: splitting costs more than it saves.
-const PARALLEL_MIN_BALLS: usize = 20_000;
 /// Bands of rows per worker thread, so an unlucky band does not leave a thread idle.
 const BANDS_PER_THREAD: usize = 4;
 
@@ -73,7 +70,7 @@ pub fn search_in_bands<T: Send + 'static>(
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
     let rows = grid.rows();
-    let pool = ComputeTaskPool::get_or_init(TaskPool::default);
+    let pool = compute_pool();
     if grid.len() < PARALLEL_MIN_BALLS || pool.thread_num() <= 1 {
         search(grid, 0..rows, found);
         return;

@@ -1,0 +1,66 @@
+//! The stages' parallel parts: work cut into pieces fixed by the input alone (never by the
+//! number of threads), run on bevy's compute pool when there is enough of it and more than
+//! one thread, their results joined in the pieces' order. So every result, down to the
+//! rounding of a sum, is the same whatever the thread count.
+
+use bevy::tasks::{ComputeTaskPool, TaskPool};
+
+/// Below this many balls a stage's work runs on the calling thread: splitting it costs more
+/// than it saves.
+pub const PARALLEL_MIN_BALLS: usize = 20_000;
+
+/// Balls in each piece of a pass over every ball: big enough that a piece outweighs handing
+/// it to a thread, small enough for 16 threads to share 100,000 balls.
+pub const BALLS_PER_PIECE: usize = 4096;
+
+/// The compute pool the parallel parts run on.
+pub fn compute_pool() -> &'static TaskPool {
+    ComputeTaskPool::get_or_init(TaskPool::default)
+}
+
+/// Whether a stage's work over `balls` balls runs in parallel: enough balls and more than one
+/// thread.
+pub fn worth_splitting(balls: usize) -> bool {
+    balls >= PARALLEL_MIN_BALLS && compute_pool().thread_num() > 1
+}
+
+/// `work` done on each of `pieces`, on the compute pool if `parallel`, the results in the
+/// pieces' order.
+pub fn in_pieces<P: Send, R: Send + 'static>(
+    pieces: impl Iterator<Item = P>,
+    parallel: bool,
+    work: impl Fn(P) -> R + Sync,
+) -> Vec<R> {
+    if !parallel {
+        return pieces.map(work).collect();
+    }
+    let work = &work;
+    compute_pool().scope(|scope| {
+        for piece in pieces {
+            scope.spawn(async move { work(piece) });
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pieces_come_back_in_order_and_alike_on_one_thread_or_many() {
+        let mut values: Vec<u64> = (0..50_000).collect();
+        let run = |values: &mut [u64], parallel: bool| {
+            in_pieces(values.chunks_mut(BALLS_PER_PIECE), parallel, |piece| {
+                piece.iter_mut().for_each(|value| *value *= 3);
+                piece.iter().sum::<u64>()
+            })
+        };
+        let serial = run(&mut values, false);
+        let parallel = run(&mut values, true);
+        assert_eq!(serial.len(), 50_000usize.div_ceil(BALLS_PER_PIECE));
+        // The second pass tripled the first's values, piece by piece.
+        let tripled: Vec<u64> = serial.iter().map(|sum| sum * 3).collect();
+        assert_eq!(parallel, tripled);
+        assert_eq!(values[49_999], 49_999 * 9);
+    }
+}
