@@ -178,8 +178,8 @@ pub fn damp_velocities(
     }
 }
 
-/// Copies every ball into the snapshot, in query order, one array at a time; remembers where
-/// each drawn ball was, for drawing between steps.
+/// Copies every ball into the snapshot, in query order; remembers where each drawn ball was,
+/// for drawing between steps.
 fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut BallSnapshot) {
     for (position, mut previous) in &mut drawn {
         previous.0 = position.0;
@@ -191,20 +191,27 @@ fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut Ball
         held,
         stopped,
     } = snapshot;
-    entities.clear();
-    entities.extend(balls.iter().map(|(ball, ..)| ball));
-    circles.clear();
-    circles.extend(
-        balls
-            .iter()
-            .map(|(_, position, _, radius, _)| Circle::new(position.0, radius.0)),
-    );
-    velocities.clear();
-    velocities.extend(balls.iter().map(|(_, _, velocity, ..)| velocity.0));
-    held.clear();
-    held.extend(balls.iter().map(|(.., rest)| rest.is_held()));
+    // Sized first and then written in place: one pass, no pushes.
+    let count = balls.iter().len();
+    entities.resize(count, Entity::PLACEHOLDER);
+    circles.resize(count, Circle::new(DVec2::ZERO, 0.0));
+    velocities.resize(count, DVec2::ZERO);
+    held.resize(count, false);
     stopped.clear();
-    stopped.resize(entities.len(), false);
+    stopped.resize(count, false);
+    let places = entities
+        .iter_mut()
+        .zip(circles.iter_mut())
+        .zip(velocities.iter_mut())
+        .zip(held.iter_mut());
+    for ((((entity, circle), velocity), held), (ball, position, ball_velocity, radius, rest)) in
+        places.zip(balls)
+    {
+        *entity = ball;
+        *circle = Circle::new(position.0, radius.0);
+        *velocity = ball_velocity.0;
+        *held = rest.is_held();
+    }
 }
 
 #[cfg(test)]

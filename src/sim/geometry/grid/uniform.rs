@@ -10,8 +10,10 @@
 use bevy::math::DVec2;
 
 use super::cells::CellMap;
+use super::counting::{NO_CELL, sort_into_cells};
 use super::rows::RowLists;
 use crate::sim::geometry::circle::Circle;
+use crate::sim::parallel::{BALLS_PER_PIECE, compute_pool, in_pieces, worth_splitting};
 
 /// A ball whose radius is more than this many times the mean radius is big: see the header.
 const BIG_RADIUS_FACTOR: f64 = 4.0;
@@ -47,9 +49,6 @@ pub struct UniformGrid {
     big_rows: RowLists,
 }
 
-/// Marks a big ball in `cell_of`.
-const NO_CELL: u32 = u32::MAX;
-
 /// Whether a ball of `radius` is big where the limit is `big_limit`. A NaN is not big.
 fn is_big(radius: f64, big_limit: f64) -> bool {
     radius > big_limit
@@ -63,74 +62,71 @@ impl UniformGrid {
 
     /// [`rebuild`](Self::rebuild) with the `count` circles made by `circle_at(index)` (each
     /// made a few times), for a caller that would otherwise keep a copy of them only to sort.
-    pub fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle) {
-        let circles = || (0..count).map(&circle_at);
-        let radius_sum: f64 = circles().map(|circle| circle.radius).sum();
-        self.big_limit = BIG_RADIUS_FACTOR * radius_sum / count.max(1) as f64;
+    pub fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle + Sync) {
+        // Every pass over the balls runs in pieces, on the compute pool for many balls.
+        let parallel = worth_splitting(count);
+        let pieces = || {
+            (0..count.div_ceil(BALLS_PER_PIECE))
+                .map(|piece| piece * BALLS_PER_PIECE..((piece + 1) * BALLS_PER_PIECE).min(count))
+        };
+        let radius_sums = in_pieces(pieces(), parallel, |balls| {
+            balls.map(|ball| circle_at(ball).radius).sum::<f64>()
+        });
+        self.big_limit = BIG_RADIUS_FACTOR * radius_sums.iter().sum::<f64>() / count.max(1) as f64;
         let big_limit = self.big_limit;
-        let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
-        for circle in circles() {
-            min = min.min(circle.center);
-            max = max.max(circle.center);
-            if !is_big(circle.radius, big_limit) {
-                largest_radius = largest_radius.max(circle.radius);
+        let bounds = in_pieces(pieces(), parallel, |balls| {
+            let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
+            for circle in balls.map(&circle_at) {
+                min = min.min(circle.center);
+                max = max.max(circle.center);
+                if !is_big(circle.radius, big_limit) {
+                    largest_radius = largest_radius.max(circle.radius);
+                }
             }
-        }
+            (min, max, largest_radius)
+        });
+        let (mut min, mut max, largest_radius) = bounds.into_iter().fold(
+            (DVec2::MAX, DVec2::MIN, 0.0_f64),
+            |(min, max, largest), piece| (min.min(piece.0), max.max(piece.1), largest.max(piece.2)),
+        );
         if count == 0 {
             (min, max) = (DVec2::ZERO, DVec2::ZERO);
         }
         self.small_reach = largest_radius;
-        self.cells = CellMap::covering(min, max, largest_radius, count);
-        let cell_count = self.cells.cell_count();
-        self.cell_start.clear();
-        self.cell_start.resize(cell_count + 1, 0);
-        self.cell_of.clear();
-        for circle in circles() {
-            if is_big(circle.radius, big_limit) {
-                self.cell_of.push(NO_CELL);
-                continue;
+        let cells = CellMap::covering(min, max, largest_radius, count);
+        self.cells = cells;
+        // Every entry of the buffers below is written before it is read: resizing them only
+        // fills what they gained since the last step.
+        self.cell_of.resize(count, NO_CELL);
+        let cell_pieces = self.cell_of.chunks_mut(BALLS_PER_PIECE).zip(pieces());
+        in_pieces(cell_pieces, parallel, |(cell_of, balls)| {
+            for (cell, circle) in cell_of.iter_mut().zip(balls.map(&circle_at)) {
+                *cell = if is_big(circle.radius, big_limit) {
+                    NO_CELL
+                } else {
+                    cells.cell_index(circle.center) as u32
+                };
             }
-            let cell = self.cells.cell_index(circle.center);
-            self.cell_of.push(cell as u32);
-            self.cell_start[cell] += 1;
-        }
-        // Inclusive prefix sums: each entry becomes its cell's end. Scattering the balls in
-        // reverse then counts each entry down to its cell's start, keeping the balls of a cell
-        // in their input order, with no second copy of the table.
-        let mut running = 0;
-        for count in &mut self.cell_start[..cell_count] {
-            running += *count;
-            *count = running;
-        }
-        self.small_count = running as usize;
-        self.cell_start[cell_count] = running;
-        self.sorted_index.resize(count, 0);
-        for (index, &cell) in self.cell_of.iter().enumerate().rev() {
-            if cell == NO_CELL {
-                continue;
-            }
-            let slot = &mut self.cell_start[cell as usize];
-            *slot -= 1;
-            self.sorted_index[*slot as usize] = index as u32;
-        }
-        if self.small_count < count {
-            let big_balls = self
-                .cell_of
-                .iter()
-                .enumerate()
-                .filter(|(_, c)| **c == NO_CELL);
-            for (slot, (index, _)) in (self.small_count..).zip(big_balls) {
-                self.sorted_index[slot] = index as u32;
-            }
-        }
-        // Scatter only the indices, then gather the circles: independent random reads overlap
-        // in the memory system far better than random writes of whole circles.
-        self.sorted_circle.clear();
-        self.sorted_circle.extend(
-            self.sorted_index
-                .iter()
-                .map(|&index| circle_at(index as usize)),
+        });
+        let bands = if parallel { 2 * compute_pool().thread_num() } else { 1 };
+        self.small_count = sort_into_cells(
+            &self.cell_of,
+            cells.cell_count(),
+            (&mut self.cell_start, &mut self.sorted_index),
+            bands,
         );
+        // The circles gathered in slot order: independent random reads overlap in the memory
+        // system far better than random writes of whole circles.
+        self.sorted_circle.resize(count, Circle::new(DVec2::ZERO, 0.0));
+        let slot_pieces = self
+            .sorted_circle
+            .chunks_mut(BALLS_PER_PIECE)
+            .zip(self.sorted_index.chunks(BALLS_PER_PIECE));
+        in_pieces(slot_pieces, parallel, |(circles, indices)| {
+            for (circle, &index) in circles.iter_mut().zip(indices) {
+                *circle = circle_at(index as usize);
+            }
+        });
         self.rebuild_big();
     }
 

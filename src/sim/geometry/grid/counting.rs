@@ -1,0 +1,144 @@
+//! The grid's counting sort: balls into cells, stable (a cell's balls keep their input
+//! order), so the slots are the same however the work is split. For many balls it runs on the
+//! compute pool in bands of cells: each band counts and places only its own cells' balls, in
+//! its own part of the slots.
+
+use std::ops::Range;
+
+use crate::sim::parallel::in_pieces;
+
+/// Marks a big ball, which has no cell.
+pub const NO_CELL: u32 = u32::MAX;
+
+/// Sorts the balls whose cells `cell_of` gives (by index; [`NO_CELL`] for a big ball) into
+/// `cell_count` cells: afterwards `cell_start[c]..cell_start[c + 1]` is cell `c`'s range of
+/// slots and `sorted_index[slot]` the ball in each slot, the balls in the cells first, in cell
+/// order, then the big ones in input order. Returns how many are in the cells. With `bands`
+/// above 1, the cells are split into that many bands, sorted in parallel.
+pub fn sort_into_cells(
+    cell_of: &[u32],
+    cell_count: usize,
+    (cell_start, sorted_index): (&mut Vec<u32>, &mut Vec<u32>),
+    bands: usize,
+) -> usize {
+    // Every entry is written below: resizing only fills what the buffers gained.
+    cell_start.resize(cell_count + 1, 0);
+    sorted_index.resize(cell_of.len(), 0);
+    let bands = bands.clamp(1, cell_count.max(1));
+    let band_cells = |band: usize| cell_count * band / bands..cell_count * (band + 1) / bands;
+    let parallel = bands > 1;
+    // Each band counts its cells' balls: `cell_start` then holds each cell's end within the band.
+    let totals = in_pieces(
+        split_by(&mut cell_start[..cell_count], (0..bands).map(band_cells)),
+        parallel,
+        |(cells, ends)| count_ends(cell_of, cells, ends),
+    );
+    let small_count: u32 = totals.iter().sum();
+    let mut band_first = 0;
+    let band_slots: Vec<Range<usize>> = totals
+        .iter()
+        .map(|&total| {
+            let slots = band_first as usize..(band_first + total) as usize;
+            band_first += total;
+            slots
+        })
+        .collect();
+    // Then places them in reverse, counting each end down to its cell's start.
+    let bands_work = split_by(&mut cell_start[..cell_count], (0..bands).map(band_cells))
+        .zip(split_by(sorted_index, band_slots.iter().cloned()))
+        .zip(&band_slots);
+    in_pieces(bands_work, parallel, |(((cells, ends), (_, slots)), range)| {
+        place(cell_of, (cells, ends), slots, range.start as u32);
+    });
+    cell_start[cell_count] = small_count;
+    let big_balls = (0..cell_of.len() as u32).filter(|&index| cell_of[index as usize] == NO_CELL);
+    for (slot, index) in sorted_index[small_count as usize..].iter_mut().zip(big_balls) {
+        *slot = index;
+    }
+    small_count as usize
+}
+
+/// `ends[c - cells.start]` set to how many balls in `cell_of` are in cells `cells.start..=c`;
+/// returns how many are in `cells`.
+fn count_ends(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32]) -> u32 {
+    ends.fill(0);
+    let (first, last) = (cells.start as u32, cells.end as u32);
+    for &cell in cell_of {
+        if (first..last).contains(&cell) {
+            ends[(cell - first) as usize] += 1;
+        }
+    }
+    let mut running = 0;
+    for end in ends.iter_mut() {
+        running += *end;
+        *end = running;
+    }
+    running
+}
+
+/// Places the balls of `cells` in `slots` (which start at slot `first_slot`), going through
+/// the balls in reverse so each cell keeps its balls in input order; `ends`, each cell's end
+/// within the band, become each cell's start slot.
+fn place(
+    cell_of: &[u32],
+    (cells, ends): (Range<usize>, &mut [u32]),
+    slots: &mut [u32],
+    first_slot: u32,
+) {
+    let (first, last) = (cells.start as u32, cells.end as u32);
+    for (index, &cell) in cell_of.iter().enumerate().rev() {
+        if (first..last).contains(&cell) {
+            let end = &mut ends[(cell - first) as usize];
+            *end -= 1;
+            slots[*end as usize] = index as u32;
+        }
+    }
+    for end in ends.iter_mut() {
+        *end += first_slot;
+    }
+}
+
+/// `items` cut into the consecutive `ranges` (which must cover it from its start, in order),
+/// each with its range.
+fn split_by<'a, T>(
+    mut items: &'a mut [T],
+    ranges: impl Iterator<Item = Range<usize>>,
+) -> impl Iterator<Item = (Range<usize>, &'a mut [T])> {
+    let mut taken = 0;
+    ranges.map(move |range| {
+        let (head, tail) = std::mem::take(&mut items).split_at_mut(range.end - taken);
+        items = tail;
+        taken = range.end;
+        (range, head)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn any_number_of_bands_sorts_stably_with_the_big_balls_last() {
+        // 3,000 balls in 97 cells, every seventh big.
+        let cell_of: Vec<u32> = (0..3000u32)
+            .map(|k| if k % 7 == 3 { NO_CELL } else { k * 31 % 97 })
+            .collect();
+        let sort = |bands: usize| {
+            let (mut starts, mut slots) = (Vec::new(), Vec::new());
+            let small = sort_into_cells(&cell_of, 97, (&mut starts, &mut slots), bands);
+            (small, starts, slots)
+        };
+        let (small, starts, slots) = sort(1);
+        assert_eq!(small, 3000 - 3000 / 7 - 1);
+        for cell in 0..97 {
+            let balls = &slots[starts[cell] as usize..starts[cell + 1] as usize];
+            assert!(balls.iter().all(|&k| cell_of[k as usize] == cell as u32));
+            assert!(balls.windows(2).all(|pair| pair[0] < pair[1]), "stable");
+        }
+        assert!(slots[small..].iter().all(|&k| k % 7 == 3));
+        assert!(slots[small..].windows(2).all(|pair| pair[0] < pair[1]));
+        for bands in [2, 3, 8, 500] {
+            assert_eq!(sort(bands), (small, starts.clone(), slots.clone()), "{bands}");
+        }
+    }
+}
