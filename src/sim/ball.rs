@@ -8,6 +8,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::geometry::Circle;
+use super::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
@@ -138,30 +139,51 @@ impl BallSnapshot {
     }
 }
 
-/// Writes each ball's new `(position, velocity)` from `new_state(index)`, where `index` is
-/// its place in the snapshot's `entities`; `None` leaves the ball as it is. The query visits
-/// the balls in the snapshot's order (nothing spawns or despawns within a step); should that
-/// ever not hold, the rest are looked up by entity.
+/// The balls as the stages write them back.
+pub type WrittenBalls<'w, 's> =
+    Query<'w, 's, (Entity, &'static mut Position, &'static mut Velocity), With<Ball>>;
+
+/// Writes every ball's position and velocity from `circles` and `velocities`, where its
+/// place in `entities` is its index. The query visits the balls in the snapshot's order
+/// (nothing spawns or despawns within a step), table by table: each table's balls are written
+/// from their part of the arrays, in pieces on the compute pool for many balls. Should the
+/// order ever not match, the rest are looked up by entity.
 pub fn write_back(
     entities: &[Entity],
-    balls: &mut Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
-    mut new_state: impl FnMut(usize) -> Option<(DVec2, DVec2)>,
+    (circles, velocities): (&[Circle], &[DVec2]),
+    balls: &mut WrittenBalls,
 ) {
-    let mut matched = 0;
-    for (index, (entity, mut position, mut velocity)) in balls.iter_mut().enumerate() {
-        if entities.get(index) != Some(&entity) {
-            break;
-        }
-        matched = index + 1;
-        if let Some(state) = new_state(index) {
-            (position.0, velocity.0) = state;
+    let parallel = worth_splitting(entities.len());
+    let mut written = 0;
+    if let Ok(tables) = balls.contiguous_iter_mut() {
+        for (table_entities, mut positions, mut table_velocities) in tables {
+            let places = written..written + table_entities.len();
+            if entities.get(places.clone()) != Some(table_entities) {
+                break;
+            }
+            let pieces = positions
+                .chunks_mut(BALLS_PER_PIECE)
+                .zip(table_velocities.chunks_mut(BALLS_PER_PIECE))
+                .zip(circles[places.clone()].chunks(BALLS_PER_PIECE))
+                .zip(velocities[places.clone()].chunks(BALLS_PER_PIECE));
+            in_pieces(
+                pieces,
+                parallel,
+                |(((positions, out), circles), velocities)| {
+                    for (position, circle) in positions.iter_mut().zip(circles) {
+                        position.0 = circle.center;
+                    }
+                    for (velocity, &new) in out.iter_mut().zip(velocities) {
+                        velocity.0 = new;
+                    }
+                },
+            );
+            written = places.end;
         }
     }
-    for (index, &entity) in entities.iter().enumerate().skip(matched) {
-        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity)
-            && let Some(state) = new_state(index)
-        {
-            (position.0, velocity.0) = state;
+    for (index, &entity) in entities.iter().enumerate().skip(written) {
+        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity) {
+            (position.0, velocity.0) = (circles[index].center, velocities[index]);
         }
     }
 }

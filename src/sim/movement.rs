@@ -24,8 +24,8 @@ use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Rest, 
 use super::clock::SimClock;
 use super::geometry::Circle;
 use super::geometry::wall::contain_at_rest;
-use super::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
-use super::params::SimParams;
+use super::parallel::{BALLS_PER_PIECE, in_pieces, take_front, worth_splitting};
+use super::params::{MassModel, SimParams};
 use super::report::{Hit, StepLog};
 use super::resting::rest_speed;
 
@@ -103,8 +103,6 @@ pub fn move_and_contain(
     mut log: ResMut<StepLog>,
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
-    let (half, restitution) = (params.half_extents(), params.restitution);
-    let rest_speed = rest_speed(&params, clock.dt);
     let snapshot = &mut *snapshot;
     fill_snapshot(&balls, drawn, snapshot);
     let BallSnapshot {
@@ -113,49 +111,90 @@ pub fn move_and_contain(
         held,
         ..
     } = snapshot;
-    let parallel = worth_splitting(circles.len());
-    let pieces = circles
-        .chunks_mut(BALLS_PER_PIECE)
-        .zip(velocities.chunks_mut(BALLS_PER_PIECE))
-        .zip(held.chunks(BALLS_PER_PIECE));
-    let contained_by_piece = in_pieces(pieces.enumerate(), parallel, |(piece, balls)| {
-        let ((circles, velocities), held) = balls;
-        let first = (piece * BALLS_PER_PIECE) as u32;
-        let mut at_walls = Vec::new();
-        for (offset, ((circle, velocity), &held)) in
-            circles.iter_mut().zip(velocities.iter_mut()).zip(held).enumerate()
-        {
-            if held {
-                continue;
-            }
-            let (moved, new_velocity) = motion.integrate(circle.center, *velocity);
-            let contained = contain_at_rest(
-                moved,
-                new_velocity,
-                circle.radius,
-                half,
-                restitution,
-                rest_speed,
-            );
-            (circle.center, *velocity) = (contained.position, contained.velocity);
-            if contained.hits != [None, None] {
-                at_walls.push((first + offset as u32, contained, circle.radius));
-            }
+    let arena = Arena::new(&params, clock.dt);
+    arena.contain(
+        (circles, velocities),
+        |index| !held[index],
+        Some(motion),
+        &mut log,
+    );
+}
+
+/// The arena's walls as the discrete mode meets them at the end of a step.
+#[derive(Clone, Copy, Debug)]
+pub struct Arena {
+    half: DVec2,
+    restitution: f64,
+    rest_speed: f64,
+    mass_model: MassModel,
+    /// When the hits are reported to have happened, seconds into the step.
+    step_end: f64,
+}
+
+impl Arena {
+    pub fn new(params: &SimParams, dt: f64) -> Self {
+        Self {
+            half: params.half_extents(),
+            restitution: params.restitution,
+            rest_speed: rest_speed(params, dt),
+            mass_model: params.mass_model,
+            step_end: dt,
         }
-        at_walls
-    });
-    // The walls' hits and resting impulses in the balls' order, as if found one by one.
-    for (index, contained, radius) in contained_by_piece.into_iter().flatten() {
-        let mass = params.mass_model.mass(radius);
-        log.resting_wall_impulse += contained.resting_impulse(mass);
-        log.hits.extend(Hit::walls_of(
-            index,
-            &contained,
-            motion.dt,
-            half,
-            restitution,
-            mass,
-        ));
+    }
+
+    /// Contains each ball that `chosen(index)` picks in the arena, after moving it by `motion`
+    /// if given, recording its wall hits and resting impulses in `log` in the balls' order.
+    /// In pieces on the compute pool for many balls.
+    pub fn contain(
+        &self,
+        (circles, velocities): (&mut [Circle], &mut [DVec2]),
+        chosen: impl Fn(usize) -> bool + Sync,
+        motion: Option<Motion>,
+        log: &mut StepLog,
+    ) {
+        let parallel = worth_splitting(circles.len());
+        let pieces = circles
+            .chunks_mut(BALLS_PER_PIECE)
+            .zip(velocities.chunks_mut(BALLS_PER_PIECE));
+        let at_walls_by_piece = in_pieces(pieces.enumerate(), parallel, |(piece, balls)| {
+            let first = piece * BALLS_PER_PIECE;
+            let mut at_walls = Vec::new();
+            for (offset, (circle, velocity)) in balls.0.iter_mut().zip(balls.1).enumerate() {
+                if !chosen(first + offset) {
+                    continue;
+                }
+                let (center, new_velocity) = match motion {
+                    Some(motion) => motion.integrate(circle.center, *velocity),
+                    None => (circle.center, *velocity),
+                };
+                let contained = contain_at_rest(
+                    center,
+                    new_velocity,
+                    circle.radius,
+                    self.half,
+                    self.restitution,
+                    self.rest_speed,
+                );
+                (circle.center, *velocity) = (contained.position, contained.velocity);
+                if contained.hits != [None, None] {
+                    at_walls.push(((first + offset) as u32, contained, circle.radius));
+                }
+            }
+            at_walls
+        });
+        // The hits and resting impulses in the balls' order, as if found one by one.
+        for (index, contained, radius) in at_walls_by_piece.into_iter().flatten() {
+            let mass = self.mass_model.mass(radius);
+            log.resting_wall_impulse += contained.resting_impulse(mass);
+            log.hits.extend(Hit::walls_of(
+                index,
+                &contained,
+                self.step_end,
+                self.half,
+                self.restitution,
+                mass,
+            ));
+        }
     }
 }
 
@@ -178,8 +217,9 @@ pub fn damp_velocities(
     }
 }
 
-/// Copies every ball into the snapshot, in query order; remembers where each drawn ball was,
-/// for drawing between steps.
+/// Copies every ball into the snapshot, in query order, table by table and in pieces on the
+/// compute pool for many balls; remembers where each drawn ball was, for drawing between
+/// steps.
 fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut BallSnapshot) {
     for (position, mut previous) in &mut drawn {
         previous.0 = position.0;
@@ -191,7 +231,7 @@ fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut Ball
         held,
         stopped,
     } = snapshot;
-    // Sized first and then written in place: one pass, no pushes.
+    // Sized first and then written in place.
     let count = balls.iter().len();
     entities.resize(count, Entity::PLACEHOLDER);
     circles.resize(count, Circle::new(DVec2::ZERO, 0.0));
@@ -199,18 +239,51 @@ fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut Ball
     held.resize(count, false);
     stopped.clear();
     stopped.resize(count, false);
-    let places = entities
-        .iter_mut()
-        .zip(circles.iter_mut())
-        .zip(velocities.iter_mut())
-        .zip(held.iter_mut());
-    for ((((entity, circle), velocity), held), (ball, position, ball_velocity, radius, rest)) in
-        places.zip(balls)
-    {
-        *entity = ball;
-        *circle = Circle::new(position.0, radius.0);
-        *velocity = ball_velocity.0;
-        *held = rest.is_held();
+    let Ok(tables) = balls.contiguous_iter() else {
+        // Not stored in tables: one ball at a time.
+        for (k, (ball, position, velocity, radius, rest)) in balls.iter().enumerate() {
+            entities[k] = ball;
+            circles[k] = Circle::new(position.0, radius.0);
+            (velocities[k], held[k]) = (velocity.0, rest.is_held());
+        }
+        return;
+    };
+    let parallel = worth_splitting(count);
+    // Each table fills the next part of the arrays.
+    let (mut places, mut circles, mut velocities, mut held) = (
+        &mut entities[..],
+        &mut circles[..],
+        &mut velocities[..],
+        &mut held[..],
+    );
+    for table in tables {
+        let len = table.0.len();
+        let out = take_front(&mut places, len)
+            .chunks_mut(BALLS_PER_PIECE)
+            .zip(take_front(&mut circles, len).chunks_mut(BALLS_PER_PIECE))
+            .zip(take_front(&mut velocities, len).chunks_mut(BALLS_PER_PIECE))
+            .zip(take_front(&mut held, len).chunks_mut(BALLS_PER_PIECE));
+        let (ball, position, velocity, radius, rest) = table;
+        let from = ball
+            .chunks(BALLS_PER_PIECE)
+            .zip(position.chunks(BALLS_PER_PIECE))
+            .zip(velocity.chunks(BALLS_PER_PIECE))
+            .zip(radius.chunks(BALLS_PER_PIECE))
+            .zip(rest.chunks(BALLS_PER_PIECE));
+        in_pieces(out.zip(from), parallel, |(out, from)| {
+            let (((places, circles), velocities), held) = out;
+            let ((((balls, positions), ball_velocities), radii), rests) = from;
+            places.copy_from_slice(balls);
+            for ((circle, position), radius) in circles.iter_mut().zip(positions).zip(radii) {
+                *circle = Circle::new(position.0, radius.0);
+            }
+            for (velocity, ball_velocity) in velocities.iter_mut().zip(ball_velocities) {
+                *velocity = ball_velocity.0;
+            }
+            for (held, rest) in held.iter_mut().zip(rests) {
+                *held = rest.is_held();
+            }
+        });
     }
 }
 

@@ -42,6 +42,27 @@ pub fn in_pieces<P: Send, R: Send + 'static>(
     })
 }
 
+/// The parts of `items` in `ranges`, which must be in order and not overlap (gaps between
+/// them are left out): disjoint slices that can go to different threads.
+pub fn carve<'a, T>(
+    mut items: &'a mut [T],
+    ranges: impl Iterator<Item = std::ops::Range<usize>>,
+) -> impl Iterator<Item = &'a mut [T]> {
+    let mut taken = 0;
+    ranges.map(move |range| {
+        take_front(&mut items, range.start - taken);
+        taken = range.end;
+        take_front(&mut items, range.len())
+    })
+}
+
+/// The first `len` of `items`, which keeps the rest.
+pub fn take_front<'a, T>(items: &mut &'a mut [T], len: usize) -> &'a mut [T] {
+    let (front, rest) = std::mem::take(items).split_at_mut(len);
+    *items = rest;
+    front
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -62,5 +83,14 @@ mod tests {
         let tripled: Vec<u64> = serial.iter().map(|sum| sum * 3).collect();
         assert_eq!(parallel, tripled);
         assert_eq!(values[49_999], 49_999 * 9);
+    }
+
+    #[test]
+    fn carving_leaves_the_gaps_out() {
+        let mut items: Vec<u32> = (0..10).collect();
+        let parts: Vec<Vec<u32>> = carve(&mut items, [1..3, 3..4, 6..9].into_iter())
+            .map(|part| part.to_vec())
+            .collect();
+        assert_eq!(parts, [vec![1, 2], vec![3], vec![6, 7, 8]]);
     }
 }

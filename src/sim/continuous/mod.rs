@@ -28,7 +28,7 @@ pub mod timeline;
 
 use bevy::prelude::*;
 
-use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
+use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back};
 use crate::sim::clock::SimClock;
 use crate::sim::params::SimParams;
 use crate::sim::report::{ContactPoint, Hit, StepLog};
@@ -59,7 +59,7 @@ pub fn run_timeline(
     params: Res<SimParams>,
     mut timeline: ResMut<Timeline>,
     mut snapshot: ResMut<BallSnapshot>,
-    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut balls: WrittenBalls,
     mut log: ResMut<StepLog>,
 ) {
     if snapshot.all_held() {
@@ -82,7 +82,5 @@ pub fn run_timeline(
     });
     log.cut_short = timeline.cut_short;
     log.resting_wall_impulse += timeline.resting_wall_impulse;
-    write_back(entities, &mut balls, |index| {
-        Some((circles[index].center, velocities[index]))
-    });
+    write_back(entities, (circles, velocities), &mut balls);
 }

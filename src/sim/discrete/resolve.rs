@@ -4,19 +4,20 @@
 //!
 //! Runs in [`SimSystems::Response`](crate::sim::SimSystems::Response) in discrete mode,
 //! reading [`Contacts`] in their stable order (Gauss–Seidel: each contact sees the velocities
-//! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then writes
-//! every ball (the movement stage moved them in the snapshot) back to its components in one
-//! pass. Records each exchange and wall
-//! hit in the [`StepLog`]. The resting rule applies to pairs and walls alike (see
-//! [`resolve_overlaps`]); pairs of resting balls are the resting stage's.
+//! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then contains
+//! the balls in a contact in the arena again and writes every ball (the movement stage moved
+//! them in the snapshot) back to its components, both in pieces on the compute pool for many
+//! balls.
+//! Records each exchange and wall hit in the [`StepLog`]. The resting rule applies to pairs
+//! and walls alike (see [`resolve_overlaps`]); pairs of resting balls are the resting stage's.
 
 use bevy::prelude::*;
 
 use super::detect::Contacts;
-use crate::sim::ball::{Ball, BallSnapshot, Position, Velocity, write_back};
+use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back};
 use crate::sim::clock::SimClock;
 use crate::sim::geometry::impulse::resolve_overlaps;
-use crate::sim::geometry::wall::contain_at_rest;
+use crate::sim::movement::Arena;
 use crate::sim::params::SimParams;
 use crate::sim::report::{Hit, StepLog};
 use crate::sim::resting::rest_speed;
@@ -26,15 +27,13 @@ pub fn resolve_contacts(
     contacts: Res<Contacts>,
     params: Res<SimParams>,
     mut snapshot: ResMut<BallSnapshot>,
-    mut balls: Query<(Entity, &mut Position, &mut Velocity), With<Ball>>,
+    mut balls: WrittenBalls,
     mut log: ResMut<StepLog>,
     mut in_contact: Local<Vec<bool>>,
 ) {
     if snapshot.all_held() {
         return; // nothing moved, and nothing touches
     }
-    // Discrete mode sees a hit only at the end of the step, as an overlap.
-    let step_end = clock.dt;
     let BallSnapshot {
         entities,
         circles,
@@ -50,49 +49,24 @@ pub fn resolve_contacts(
             in_contact[contact.b as usize],
         ) = (true, true);
     }
-    let pairs = contacts.0.iter().map(|contact| (contact.a, contact.b));
-    let (mass_model, restitution) = (params.mass_model, params.restitution);
     let rest_speed = rest_speed(&params, clock.dt);
+    let constants = (params.mass_model, params.restitution, rest_speed);
+    // Discrete mode sees a hit only at the end of the step, as an overlap.
+    let step_end = clock.dt;
     let log = &mut *log;
     let hits = &mut log.hits;
     resolve_overlaps(
-        pairs,
+        contacts.0.iter().map(|contact| (contact.a, contact.b)),
         circles,
         velocities,
         held,
-        (mass_model, restitution, rest_speed),
+        constants,
         |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange)),
     );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
     // the movement stage kept every ball inside, so only they need the walls again.
-    let half = params.half_extents();
-    let resting_wall_impulse = &mut log.resting_wall_impulse;
-    for (index, _) in in_contact.iter().enumerate().filter(|(_, touched)| **touched) {
-        let circle = circles[index];
-        let contained = contain_at_rest(
-            circle.center,
-            velocities[index],
-            circle.radius,
-            half,
-            restitution,
-            rest_speed,
-        );
-        if contained.hits != [None, None] {
-            let mass = mass_model.mass(circle.radius);
-            *resting_wall_impulse += contained.resting_impulse(mass);
-            hits.extend(Hit::walls_of(
-                index as u32,
-                &contained,
-                step_end,
-                half,
-                restitution,
-                mass,
-            ));
-        }
-        (circles[index].center, velocities[index]) = (contained.position, contained.velocity);
-    }
+    let arena = Arena::new(&params, clock.dt);
+    arena.contain((circles, velocities), |index| in_contact[index], None, log);
     // Every ball: the movement stage moved them in the snapshot only.
-    write_back(entities, &mut balls, |index| {
-        Some((circles[index].center, velocities[index]))
-    });
+    write_back(entities, (circles, velocities), &mut balls);
 }

@@ -5,7 +5,7 @@
 
 use std::ops::Range;
 
-use crate::sim::parallel::in_pieces;
+use crate::sim::parallel::{carve, in_pieces};
 
 /// Marks a big ball, which has no cell.
 pub const NO_CELL: u32 = u32::MAX;
@@ -29,7 +29,10 @@ pub fn sort_into_cells(
     let parallel = bands > 1;
     // Each band counts its cells' balls: `cell_start` then holds each cell's end within the band.
     let totals = in_pieces(
-        split_by(&mut cell_start[..cell_count], (0..bands).map(band_cells)),
+        (0..bands).map(band_cells).zip(carve(
+            &mut cell_start[..cell_count],
+            (0..bands).map(band_cells),
+        )),
         parallel,
         |(cells, ends)| count_ends(cell_of, cells, ends),
     );
@@ -44,15 +47,23 @@ pub fn sort_into_cells(
         })
         .collect();
     // Then places them in reverse, counting each end down to its cell's start.
-    let bands_work = split_by(&mut cell_start[..cell_count], (0..bands).map(band_cells))
-        .zip(split_by(sorted_index, band_slots.iter().cloned()))
+    let bands_work = (0..bands)
+        .map(band_cells)
+        .zip(carve(
+            &mut cell_start[..cell_count],
+            (0..bands).map(band_cells),
+        ))
+        .zip(carve(sorted_index, band_slots.iter().cloned()))
         .zip(&band_slots);
-    in_pieces(bands_work, parallel, |(((cells, ends), (_, slots)), range)| {
+    in_pieces(bands_work, parallel, |(((cells, ends), slots), range)| {
         place(cell_of, (cells, ends), slots, range.start as u32);
     });
     cell_start[cell_count] = small_count;
     let big_balls = (0..cell_of.len() as u32).filter(|&index| cell_of[index as usize] == NO_CELL);
-    for (slot, index) in sorted_index[small_count as usize..].iter_mut().zip(big_balls) {
+    for (slot, index) in sorted_index[small_count as usize..]
+        .iter_mut()
+        .zip(big_balls)
+    {
         *slot = index;
     }
     small_count as usize
@@ -98,21 +109,6 @@ fn place(
     }
 }
 
-/// `items` cut into the consecutive `ranges` (which must cover it from its start, in order),
-/// each with its range.
-fn split_by<'a, T>(
-    mut items: &'a mut [T],
-    ranges: impl Iterator<Item = Range<usize>>,
-) -> impl Iterator<Item = (Range<usize>, &'a mut [T])> {
-    let mut taken = 0;
-    ranges.map(move |range| {
-        let (head, tail) = std::mem::take(&mut items).split_at_mut(range.end - taken);
-        items = tail;
-        taken = range.end;
-        (range, head)
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,7 +134,11 @@ mod tests {
         assert!(slots[small..].iter().all(|&k| k % 7 == 3));
         assert!(slots[small..].windows(2).all(|pair| pair[0] < pair[1]));
         for bands in [2, 3, 8, 500] {
-            assert_eq!(sort(bands), (small, starts.clone(), slots.clone()), "{bands}");
+            assert_eq!(
+                sort(bands),
+                (small, starts.clone(), slots.clone()),
+                "{bands}"
+            );
         }
     }
 }

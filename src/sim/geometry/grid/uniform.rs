@@ -108,7 +108,11 @@ impl UniformGrid {
                 };
             }
         });
-        let bands = if parallel { 2 * compute_pool().thread_num() } else { 1 };
+        let bands = if parallel {
+            2 * compute_pool().thread_num()
+        } else {
+            1
+        };
         self.small_count = sort_into_cells(
             &self.cell_of,
             cells.cell_count(),
@@ -117,7 +121,8 @@ impl UniformGrid {
         );
         // The circles gathered in slot order: independent random reads overlap in the memory
         // system far better than random writes of whole circles.
-        self.sorted_circle.resize(count, Circle::new(DVec2::ZERO, 0.0));
+        self.sorted_circle
+            .resize(count, Circle::new(DVec2::ZERO, 0.0));
         let slot_pieces = self
             .sorted_circle
             .chunks_mut(BALLS_PER_PIECE)
