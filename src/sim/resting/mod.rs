@@ -113,8 +113,12 @@ pub fn rest_and_sleep(
         mode: solver.collisions,
     };
     let changed = state.last_key.replace(key).is_some_and(|last| last != key);
-    // Read from the components in place: the elastic gas then never copies a ball's `Rest`.
-    let anyone_held = balls.iter().any(|(.., rest)| rest.is_held());
+    // Read from the components in place, table by table: the elastic gas then never copies a
+    // ball's `Rest`.
+    let anyone_held = match balls.contiguous_iter() {
+        Ok(mut tables) => tables.any(|(.., rests)| rests.iter().any(Rest::is_held)),
+        Err(_) => balls.iter().any(|(.., rest)| rest.is_held()),
+    };
     if rest_speed == 0.0 && !anyone_held {
         state.warm.clear();
         return; // the rule is off and nobody rests: the elastic paths stay untouched
