@@ -23,7 +23,7 @@ use bevy::prelude::*;
 use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Rest, Velocity};
 use super::clock::SimClock;
 use super::geometry::Circle;
-use super::geometry::wall::contain_at_rest;
+use super::geometry::wall::contain_chosen;
 use super::parallel::{BALLS_PER_PIECE, in_pieces, take_front, worth_splitting};
 use super::params::{MassModel, SimParams};
 use super::report::{Hit, StepLog};
@@ -147,44 +147,20 @@ impl Arena {
     /// In pieces on the compute pool for many balls.
     pub fn contain(
         &self,
-        (circles, velocities): (&mut [Circle], &mut [DVec2]),
+        balls: (&mut [Circle], &mut [DVec2]),
         chosen: impl Fn(usize) -> bool + Sync,
         motion: Option<Motion>,
         log: &mut StepLog,
     ) {
-        let parallel = worth_splitting(circles.len());
-        let pieces = circles
-            .chunks_mut(BALLS_PER_PIECE)
-            .zip(velocities.chunks_mut(BALLS_PER_PIECE));
-        let at_walls_by_piece = in_pieces(pieces.enumerate(), parallel, |(piece, balls)| {
-            let first = piece * BALLS_PER_PIECE;
-            let mut at_walls = Vec::new();
-            for (offset, (circle, velocity)) in balls.0.iter_mut().zip(balls.1).enumerate() {
-                if !chosen(first + offset) {
-                    continue;
-                }
-                let (center, new_velocity) = match motion {
-                    Some(motion) => motion.integrate(circle.center, *velocity),
-                    None => (circle.center, *velocity),
-                };
-                let contained = contain_at_rest(
-                    center,
-                    new_velocity,
-                    circle.radius,
-                    self.half,
-                    self.restitution,
-                    self.rest_speed,
-                );
-                (circle.center, *velocity) = (contained.position, contained.velocity);
-                if contained.hits != [None, None] {
-                    at_walls.push(((first + offset) as u32, contained, circle.radius));
-                }
-            }
-            at_walls
-        });
+        let moved = |center, velocity| match motion {
+            Some(motion) => motion.integrate(center, velocity),
+            None => (center, velocity),
+        };
+        let arena = (self.half, self.restitution, self.rest_speed);
+        let at_walls = contain_chosen((&mut *balls.0, &mut *balls.1), chosen, moved, arena);
         // The hits and resting impulses in the balls' order, as if found one by one.
-        for (index, contained, radius) in at_walls_by_piece.into_iter().flatten() {
-            let mass = self.mass_model.mass(radius);
+        for (index, contained) in at_walls {
+            let mass = self.mass_model.mass(balls.0[index as usize].radius);
             log.resting_wall_impulse += contained.resting_impulse(mass);
             log.hits.extend(Hit::walls_of(
                 index,

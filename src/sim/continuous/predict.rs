@@ -17,6 +17,7 @@ use crate::sim::geometry::circle::{Circle, circles_touch, overlapping};
 use crate::sim::geometry::flight::time_to_touch;
 use crate::sim::geometry::pairs::search_in_bands;
 use crate::sim::geometry::wall::wall_time_of_impact;
+use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 
 /// Pixels added to a redirected ball's swept circle, so rounding can never make the swept
 /// circles' test reject a pair that touches at the very edge of the step.
@@ -40,22 +41,46 @@ impl Timeline {
         });
         // From here on every ball is known by its slot in the grid's cell order.
         self.grid.renumber_by_slot(&mut self.order);
-        self.movers.clear();
-        self.movers.extend(self.order.iter().map(|&ball| {
-            let ball = ball as usize;
-            Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball])
-        }));
-        self.predictions.clear();
+        // Each ball on the timeline, and its first wall impact, in pieces of slots on the
+        // compute pool for many balls.
+        let still = Mover::new(
+            Circle::new(DVec2::ZERO, 0.0),
+            DVec2::ZERO,
+            DVec2::ZERO,
+            true,
+        );
+        self.movers.resize(self.order.len(), still);
+        let (grid, order) = (&self.grid, &self.order);
+        let pieces = self
+            .movers
+            .chunks_mut(BALLS_PER_PIECE)
+            .zip(order.chunks(BALLS_PER_PIECE))
+            .enumerate();
+        let walls = in_pieces(
+            pieces,
+            worth_splitting(order.len()),
+            |(piece, (movers, balls))| {
+                let first = piece * BALLS_PER_PIECE;
+                let mut walls = Vec::new();
+                for (offset, (mover, &ball)) in movers.iter_mut().zip(balls).enumerate() {
+                    let ball = ball as usize;
+                    *mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+                    let slot = first + offset;
+                    if let Some((time, wall)) = wall_time(mover, grid.circle_in_slot(slot), spec)
+                        && time <= dt
+                    {
+                        let impact = Impact::with_wall(time, Party::new(slot, order, 0), wall);
+                        walls.push(Prediction::Impact(impact));
+                    }
+                }
+                walls
+            },
+        );
         // The walls first: the pair search then grows the buffer by exactly what it finds.
-        for (slot, mover) in self.movers.iter().enumerate() {
-            let swept = self.grid.circle_in_slot(slot);
-            if let Some((time, wall)) = wall_time(mover, swept, spec)
-                && time <= dt
-            {
-                let impact = Impact::with_wall(time, Party::new(slot, &self.order, 0), wall);
-                self.predictions.push(Prediction::Impact(impact));
-            }
-        }
+        self.predictions.clear();
+        self.predictions
+            .reserve_exact(walls.iter().map(Vec::len).sum());
+        self.predictions.extend(walls.into_iter().flatten());
         let flying = self.movers.iter().filter(|mover| !mover.still).count();
         if flying * FEW_FLYING < self.movers.len() {
             self.predict_around_the_flying(dt);

@@ -20,7 +20,8 @@ use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
 use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
 use crate::sim::geometry::pairs::find_contacts;
-use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_at_rest};
+use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_chosen};
+use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 use crate::sim::params::BroadPhase;
 use crate::sim::report::Hit;
 
@@ -253,9 +254,16 @@ impl Timeline {
         (held, stopped): (&mut [bool], &mut [bool]),
         spec: StepSpec,
     ) {
-        for (&ball, mover) in self.order.iter().zip(&mut self.movers) {
+        let parallel = worth_splitting(self.movers.len());
+        in_pieces(
+            self.movers.chunks_mut(BALLS_PER_PIECE),
+            parallel,
+            |movers| {
+                movers.iter_mut().for_each(|mover| mover.advance(spec.dt));
+            },
+        );
+        for (&ball, mover) in self.order.iter().zip(&self.movers) {
             let index = ball as usize;
-            mover.advance(spec.dt);
             (circles[index].center, velocities[index]) = (mover.center, mover.velocity);
             held[index] &= mover.still && mover.hits == 0;
             stopped[index] = mover.still && !held[index];
@@ -344,21 +352,14 @@ fn contain_at_the_end(
     spec: StepSpec,
     on_hit: &mut impl FnMut(Hit),
 ) -> f64 {
+    let arena = (spec.half, spec.restitution, spec.rest_speed);
+    let at_walls = contain_chosen((circles, velocities), |_| true, |c, v| (c, v), arena);
     let mut resting_impulse = 0.0;
-    for (index, (circle, velocity)) in circles.iter_mut().zip(velocities.iter_mut()).enumerate() {
-        let contained = contain_at_rest(
-            circle.center,
-            *velocity,
-            circle.radius,
-            spec.half,
-            spec.restitution,
-            spec.rest_speed,
-        );
-        (circle.center, *velocity) = (contained.position, contained.velocity);
-        let mass = spec.mass_model.mass(circle.radius);
+    for (index, contained) in at_walls {
+        let mass = spec.mass_model.mass(circles[index as usize].radius);
         resting_impulse += contained.resting_impulse(mass);
         for hit in Hit::walls_of(
-            index as u32,
+            index,
             &contained,
             spec.dt,
             spec.half,

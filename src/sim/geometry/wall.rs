@@ -4,13 +4,15 @@
 //! The discrete mode contains every ball after moving it ([`contain_in_arena`]); the
 //! continuous mode finds each ball's exact moment at a wall ([`wall_time_of_impact`]) and
 //! bounces it there ([`bounce_off_wall`]), then contains at the end of the step against
-//! rounding; the aiming guide uses the same time of impact.
+//! rounding; the aiming guide uses the same time of impact. Both contain many balls at once
+//! with [`contain_chosen`], in parallel for many balls.
 
 use bevy::math::DVec2;
 
 use super::circle::{Circle, MIN_APPROACH_SPEED};
 use super::flight::time_to_reach;
 use super::impulse::wall_impulse;
+use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 
 /// The four sides of the arena.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -129,6 +131,51 @@ pub fn contain_at_rest(
         velocity,
         hits,
     }
+}
+
+/// [`contain_at_rest`] for each ball that `chosen(index)` picks, where `moved(center,
+/// velocity)` takes it first (the discrete mode's movement; for a ball already moved, the two
+/// as they are), with the arena's `(half, restitution, rest_speed)`. Updates `circles` and
+/// `velocities` in place, in pieces on the compute pool for many balls, and returns the balls
+/// that met a wall, in index order.
+pub fn contain_chosen(
+    (circles, velocities): (&mut [Circle], &mut [DVec2]),
+    chosen: impl Fn(usize) -> bool + Sync,
+    moved: impl Fn(DVec2, DVec2) -> (DVec2, DVec2) + Sync,
+    (half, restitution, rest_speed): (DVec2, f64, f64),
+) -> Vec<(u32, Contained)> {
+    let parallel = worth_splitting(circles.len());
+    let pieces = circles
+        .chunks_mut(BALLS_PER_PIECE)
+        .zip(velocities.chunks_mut(BALLS_PER_PIECE));
+    let by_piece = in_pieces(
+        pieces.enumerate(),
+        parallel,
+        |(piece, (circles, velocities))| {
+            let first = piece * BALLS_PER_PIECE;
+            let mut at_walls = Vec::new();
+            for (offset, (circle, velocity)) in circles.iter_mut().zip(velocities).enumerate() {
+                if !chosen(first + offset) {
+                    continue;
+                }
+                let (center, new_velocity) = moved(circle.center, *velocity);
+                let contained = contain_at_rest(
+                    center,
+                    new_velocity,
+                    circle.radius,
+                    half,
+                    restitution,
+                    rest_speed,
+                );
+                (circle.center, *velocity) = (contained.position, contained.velocity);
+                if contained.hits != [None, None] {
+                    at_walls.push(((first + offset) as u32, contained));
+                }
+            }
+            at_walls
+        },
+    );
+    by_piece.into_iter().flatten().collect()
 }
 
 /// Where a ball at `position` touches `wall` of the arena `[-half, half]`.
