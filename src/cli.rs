@@ -172,7 +172,8 @@ pub struct RunArgs {
     /// Write the final state of every ball to this JSON file.
     #[arg(long, value_name = "OUT.json")]
     pub dump: Option<PathBuf>,
-    /// Worker threads for the parallel parts of the stages (default: as many as cores).
+    /// Threads at work on each step: this one and `T - 1` workers for the stages' parallel
+    /// parts (default: bevy's compute pool for this machine's cores, and this thread).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
     pub threads: Option<u64>,
     /// Collision mode, overriding the scene's (default: continuous).

@@ -20,14 +20,16 @@ pub fn headless_app(dt: f64) -> App {
     headless_app_with_threads(dt, None)
 }
 
-/// [`headless_app`] with the compute pool (which runs the parallel parts of the stages) set to
-/// `compute_threads` threads. Bevy's task pools belong to the process: only the first app in
-/// a process sets them.
-pub fn headless_app_with_threads(dt: f64, compute_threads: Option<usize>) -> App {
+/// [`headless_app`] with `threads` threads at work on each step: the calling thread, which
+/// runs the schedule and takes its share of the stages' parallel parts, and `threads - 1`
+/// workers in the compute pool. Bevy's task pools belong to the process: only the first app
+/// in a process sets them.
+pub fn headless_app_with_threads(dt: f64, threads: Option<usize>) -> App {
     let mut task_pool_options = TaskPoolOptions::default();
-    if let Some(threads) = compute_threads {
-        task_pool_options.compute.min_threads = threads;
-        task_pool_options.compute.max_threads = threads;
+    if let Some(threads) = threads {
+        let workers = threads.saturating_sub(1);
+        task_pool_options.compute.min_threads = workers;
+        task_pool_options.compute.max_threads = workers;
     }
     let mut app = App::new();
     app.add_plugins((

@@ -18,10 +18,16 @@ pub fn compute_pool() -> &'static TaskPool {
     ComputeTaskPool::get_or_init(TaskPool::default)
 }
 
+/// The threads that work on a stage's parallel parts: the compute pool's workers and the
+/// thread that runs the stage, which takes its share while it waits for them.
+pub fn threads_at_work() -> usize {
+    compute_pool().thread_num() + 1
+}
+
 /// Whether a stage's work over `balls` balls runs in parallel: enough balls and more than one
-/// thread.
+/// thread at work.
 pub fn worth_splitting(balls: usize) -> bool {
-    balls >= PARALLEL_MIN_BALLS && compute_pool().thread_num() > 1
+    balls >= PARALLEL_MIN_BALLS && threads_at_work() > 1
 }
 
 /// `work` done on each of `pieces`, on the compute pool if `parallel`, the results in the

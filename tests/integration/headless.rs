@@ -90,3 +90,57 @@ fn a_headless_ball_has_no_drawing_state_and_one_given_it_follows_the_steps() {
     );
     assert!(previous.x > 3.0, "it moved with the steps: {previous}");
 }
+
+/// Marks balls so that they are stored in a table of their own.
+#[derive(Component)]
+struct Tagged;
+
+#[test]
+fn balls_stored_in_two_tables_are_each_read_and_written_back_as_themselves() {
+    // The stages read and write the balls table by table: here two, interleaved by id.
+    // A head-on pair (one ball in each table, equal masses) and two lone balls.
+    let balls = [
+        ball(-100.0, 0.0, 60.0, 0.0, 10.0),
+        ball(100.0, 0.0, -60.0, 0.0, 10.0),
+        ball(-200.0, 150.0, 30.0, -12.0, 8.0),
+        ball(200.0, -150.0, -24.0, 18.0, 8.0),
+    ];
+    for (mode, place_tolerance) in [
+        (CollisionMode::Continuous, 1e-9),
+        // Seen at the end of a step, as an overlap, and pushed apart.
+        (CollisionMode::Discrete, 2.0),
+    ] {
+        let mut app = app_in(mode, SimParams::default(), &balls);
+        for id in [1, 3] {
+            let entity = entity_of(&mut app, id);
+            app.world_mut().entity_mut(entity).insert(Tagged);
+        }
+        let world = app.world_mut();
+        assert_eq!(world.query::<&Tagged>().iter(world).count(), 2);
+        // 2 s: the pair meets after 1.5 s (180 px apart, closing at 120 px/s).
+        step(&mut app, 120);
+        let after = states(&mut app);
+        for lone in [2, 3] {
+            let expected = balls[lone].position + balls[lone].velocity * 2.0;
+            assert!(
+                after[lone].position.distance(expected) < 1e-9,
+                "{mode:?}: ball {lone} at {} instead of {expected}",
+                after[lone].position
+            );
+            assert_eq!(after[lone].velocity, balls[lone].velocity, "{mode:?}");
+        }
+        // Equal masses head on: the velocities are exchanged, each ball back 30 px.
+        for (id, x, vx) in [(0, -40.0, -60.0), (1, 40.0, 60.0)] {
+            assert!(
+                (after[id].velocity.x - vx).abs() < 1e-9 && after[id].velocity.y.abs() < 1e-9,
+                "{mode:?}: ball {id} at {}",
+                after[id].velocity
+            );
+            assert!(
+                (after[id].position.x - x).abs() < place_tolerance,
+                "{mode:?}: ball {id} at {}",
+                after[id].position
+            );
+        }
+    }
+}

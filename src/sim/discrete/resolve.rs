@@ -43,20 +43,20 @@ pub fn resolve_contacts(
     } = &mut *snapshot;
     in_contact.clear();
     in_contact.resize(entities.len(), false);
-    for contact in &contacts.0 {
-        (
-            in_contact[contact.a as usize],
-            in_contact[contact.b as usize],
-        ) = (true, true);
-    }
     let rest_speed = rest_speed(&params, clock.dt);
     let constants = (params.mass_model, params.restitution, rest_speed);
     // Discrete mode sees a hit only at the end of the step, as an overlap.
     let step_end = clock.dt;
     let log = &mut *log;
     let hits = &mut log.hits;
+    // Each pair's balls marked as it is taken, while they are in the cache.
+    let pairs = contacts.0.iter().map(|contact| {
+        let (a, b) = (contact.a, contact.b);
+        (in_contact[a as usize], in_contact[b as usize]) = (true, true);
+        (a, b)
+    });
     resolve_overlaps(
-        contacts.0.iter().map(|contact| (contact.a, contact.b)),
+        pairs,
         circles,
         velocities,
         held,

@@ -6,7 +6,7 @@ use std::ops::Range;
 
 use super::circle::{Circle, ContactGeometry, circle_contact, circles_touch};
 use super::grid::{UniformGrid, for_each_pair};
-use crate::sim::parallel::{PARALLEL_MIN_BALLS, compute_pool};
+use crate::sim::parallel::{compute_pool, threads_at_work, worth_splitting};
 use crate::sim::params::BroadPhase;
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
@@ -62,7 +62,7 @@ pub fn find_touching_pairs(
 /// Runs `search(grid, rows, out)` over bands of the grid's rows and appends what the bands
 /// find to `found` in row order, so the result does not depend on the thread count. The bands
 /// run in parallel on the compute pool once the grid holds `PARALLEL_MIN_BALLS` (20,000) balls
-/// and the pool has more than one thread; otherwise one pass over every row finds the same,
+/// and more than one thread is at work; otherwise one pass over every row finds the same,
 /// in the same order, with no band's buffer beside `found` (10 MB at a million balls).
 pub fn search_in_bands<T: Send + 'static>(
     grid: &UniformGrid,
@@ -70,12 +70,11 @@ pub fn search_in_bands<T: Send + 'static>(
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
     let rows = grid.rows();
-    let pool = compute_pool();
-    if grid.len() < PARALLEL_MIN_BALLS || pool.thread_num() <= 1 {
+    if !worth_splitting(grid.len()) {
         search(grid, 0..rows, found);
         return;
     }
-    let band_count = (pool.thread_num() * BANDS_PER_THREAD).max(1);
+    let band_count = threads_at_work() * BANDS_PER_THREAD;
     let search = &search;
     // `found` kept last step's size: each band starts with its share and an eighth more, so
     // the bands' buffers, all alive until joined, are not doubled past what they hold; made
@@ -84,7 +83,7 @@ pub fn search_in_bands<T: Send + 'static>(
     let mut bands: Vec<Vec<T>> = (0..band_count)
         .map(|_| Vec::with_capacity(share + share / 8))
         .collect();
-    pool.scope(|scope| {
+    compute_pool().scope(|scope| {
         for (band, local) in bands.iter_mut().enumerate() {
             let band_rows = rows * band / band_count..rows * (band + 1) / band_count;
             scope.spawn(async move { search(grid, band_rows, local) });
@@ -116,6 +115,7 @@ fn keep_touching(found: &mut Vec<IndexedContact>) -> impl FnMut(u32, u32, Circle
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::parallel::PARALLEL_MIN_BALLS;
     use bevy::math::DVec2;
 
     #[test]

@@ -13,7 +13,7 @@ use super::cells::CellMap;
 use super::counting::{NO_CELL, sort_into_cells};
 use super::rows::RowLists;
 use crate::sim::geometry::circle::Circle;
-use crate::sim::parallel::{BALLS_PER_PIECE, compute_pool, in_pieces, worth_splitting};
+use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, threads_at_work, worth_splitting};
 
 /// A ball whose radius is more than this many times the mean radius is big: see the header.
 const BIG_RADIUS_FACTOR: f64 = 4.0;
@@ -108,11 +108,7 @@ impl UniformGrid {
                 };
             }
         });
-        let bands = if parallel {
-            2 * compute_pool().thread_num()
-        } else {
-            1
-        };
+        let bands = if parallel { 2 * threads_at_work() } else { 1 };
         self.small_count = sort_into_cells(
             &self.cell_of,
             cells.cell_count(),
