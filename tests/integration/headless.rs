@@ -119,9 +119,12 @@ fn balls_stored_in_two_tables_are_each_read_and_written_back_as_themselves() {
         assert_eq!(world.query::<&Tagged>().iter(world).count(), 2);
         // 2 s: the pair meets after 1.5 s (180 px apart, closing at 120 px/s).
         step(&mut app, 120);
+        // The fixed step is 1/60 s to a few parts in 10^8.
+        let elapsed = app.world().resource::<SimClock>().elapsed;
+        assert!((elapsed - 2.0).abs() < 1e-6, "{elapsed}");
         let after = states(&mut app);
         for lone in [2, 3] {
-            let expected = balls[lone].position + balls[lone].velocity * 2.0;
+            let expected = balls[lone].position + balls[lone].velocity * elapsed;
             assert!(
                 after[lone].position.distance(expected) < 1e-9,
                 "{mode:?}: ball {lone} at {} instead of {expected}",
@@ -129,8 +132,10 @@ fn balls_stored_in_two_tables_are_each_read_and_written_back_as_themselves() {
             );
             assert_eq!(after[lone].velocity, balls[lone].velocity, "{mode:?}");
         }
-        // Equal masses head on: the velocities are exchanged, each ball back 30 px.
-        for (id, x, vx) in [(0, -40.0, -60.0), (1, 40.0, 60.0)] {
+        // Equal masses head on, touching at ±10 px: the velocities are exchanged, each ball
+        // 30 px back by 2 s.
+        let back = 60.0 * (elapsed - 1.5);
+        for (id, x, vx) in [(0, -10.0 - back, -60.0), (1, 10.0 + back, 60.0)] {
             assert!(
                 (after[id].velocity.x - vx).abs() < 1e-9 && after[id].velocity.y.abs() < 1e-9,
                 "{mode:?}: ball {id} at {}",

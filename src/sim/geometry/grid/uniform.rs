@@ -108,7 +108,7 @@ impl UniformGrid {
                 };
             }
         });
-        let bands = if parallel { 2 * threads_at_work() } else { 1 };
+        let bands = if parallel { threads_at_work() } else { 1 };
         self.small_count = sort_into_cells(
             &self.cell_of,
             cells.cell_count(),
