@@ -45,7 +45,7 @@ pub struct CaseResult {
     pub case: BenchCase,
     /// Cores the process could use.
     pub cores: usize,
-    /// Worker threads of the compute pool.
+    /// Threads at work on each step (the main thread and the compute pool's workers).
     pub threads: usize,
     pub ms_per_step_median: f64,
     pub ns_per_ball_step: f64,
@@ -111,8 +111,8 @@ pub fn peak_rss_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
-/// Runs `case` in a child process: on one core with one worker thread if `one_core` (via
-/// `taskset`), else with a worker thread per core.
+/// Runs `case` in a child process: on one core with one thread if `one_core` (via
+/// `taskset`), else with a thread per core (the main thread and a worker for each other core).
 pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, Box<dyn Error>> {
     let threads = if one_core { 1 } else { available_cores() };
     let exe = std::env::current_exe()?;

@@ -50,10 +50,10 @@ pub fn in_pieces<P: Send, R: Send + 'static>(
 
 /// The parts of `items` in `ranges`, which must be in order and not overlap (gaps between
 /// them are left out): disjoint slices that can go to different threads.
-pub fn carve<'a, T>(
-    mut items: &'a mut [T],
+pub fn carve<T>(
+    mut items: &mut [T],
     ranges: impl Iterator<Item = std::ops::Range<usize>>,
-) -> impl Iterator<Item = &'a mut [T]> {
+) -> impl Iterator<Item = &mut [T]> {
     let mut taken = 0;
     ranges.map(move |range| {
         take_front(&mut items, range.start - taken);
