@@ -1,5 +1,6 @@
 //! The ball components, the simulation's state, one entity per ball; and the
-//! [`BallSnapshot`], the same balls in contiguous arrays for the stages to work on.
+//! [`BallSnapshot`], the same balls in contiguous arrays for the stages to work on, filled
+//! from the components and written back to them table by table, in parallel for many balls.
 //!
 //! Positions and velocities are `f64`: the collision maths (and the continuous mode's time of
 //! impact) keep energy to 1e-6 only with that precision. Rendering converts to `f32`.
@@ -8,7 +9,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::geometry::Circle;
-use super::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
+use super::parallel::{BALLS_PER_PIECE, in_pieces, take_front, worth_splitting};
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
@@ -137,7 +138,87 @@ impl BallSnapshot {
     pub fn all_held(&self) -> bool {
         self.held.iter().all(|&held| held)
     }
+
+    /// Copies every ball into the snapshot, in query order, table by table and in pieces on
+    /// the compute pool for many balls.
+    pub fn fill(&mut self, balls: &SnapshotBalls) {
+        let BallSnapshot {
+            entities,
+            circles,
+            velocities,
+            held,
+            stopped,
+        } = self;
+        // Sized first and then written in place.
+        let count = balls.iter().len();
+        entities.resize(count, Entity::PLACEHOLDER);
+        circles.resize(count, Circle::new(DVec2::ZERO, 0.0));
+        velocities.resize(count, DVec2::ZERO);
+        held.resize(count, false);
+        stopped.clear();
+        stopped.resize(count, false);
+        let Ok(tables) = balls.contiguous_iter() else {
+            // Not stored in tables: one ball at a time.
+            for (k, (ball, position, velocity, radius, rest)) in balls.iter().enumerate() {
+                entities[k] = ball;
+                circles[k] = Circle::new(position.0, radius.0);
+                (velocities[k], held[k]) = (velocity.0, rest.is_held());
+            }
+            return;
+        };
+        let parallel = worth_splitting(count);
+        // Each table fills the next part of the arrays.
+        let (mut places, mut circles, mut velocities, mut held) = (
+            &mut entities[..],
+            &mut circles[..],
+            &mut velocities[..],
+            &mut held[..],
+        );
+        for table in tables {
+            let len = table.0.len();
+            let out = take_front(&mut places, len)
+                .chunks_mut(BALLS_PER_PIECE)
+                .zip(take_front(&mut circles, len).chunks_mut(BALLS_PER_PIECE))
+                .zip(take_front(&mut velocities, len).chunks_mut(BALLS_PER_PIECE))
+                .zip(take_front(&mut held, len).chunks_mut(BALLS_PER_PIECE));
+            let (ball, position, velocity, radius, rest) = table;
+            let from = ball
+                .chunks(BALLS_PER_PIECE)
+                .zip(position.chunks(BALLS_PER_PIECE))
+                .zip(velocity.chunks(BALLS_PER_PIECE))
+                .zip(radius.chunks(BALLS_PER_PIECE))
+                .zip(rest.chunks(BALLS_PER_PIECE));
+            in_pieces(out.zip(from), parallel, |(out, from)| {
+                let (((places, circles), velocities), held) = out;
+                let ((((balls, positions), ball_velocities), radii), rests) = from;
+                places.copy_from_slice(balls);
+                for ((circle, position), radius) in circles.iter_mut().zip(positions).zip(radii) {
+                    *circle = Circle::new(position.0, radius.0);
+                }
+                for (velocity, ball_velocity) in velocities.iter_mut().zip(ball_velocities) {
+                    *velocity = ball_velocity.0;
+                }
+                for (held, rest) in held.iter_mut().zip(rests) {
+                    *held = rest.is_held();
+                }
+            });
+        }
+    }
 }
+
+/// The balls as the movement stage copies them into the snapshot.
+pub type SnapshotBalls<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Position,
+        &'static Velocity,
+        &'static Radius,
+        &'static Rest,
+    ),
+    With<Ball>,
+>;
 
 /// The balls as the stages write them back.
 pub type WrittenBalls<'w, 's> =

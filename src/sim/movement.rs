@@ -20,29 +20,13 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, Radius, Rest, Velocity};
+use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, SnapshotBalls};
 use super::clock::SimClock;
 use super::geometry::Circle;
 use super::geometry::wall::contain_chosen;
-use super::parallel::{BALLS_PER_PIECE, in_pieces, take_front, worth_splitting};
 use super::params::{MassModel, SimParams};
 use super::report::{Hit, StepLog};
 use super::resting::rest_speed;
-
-/// The balls as the movement stage reads them: it moves the snapshot, and the response
-/// writes the balls back.
-type MovingBalls<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static Position,
-        &'static Velocity,
-        &'static Radius,
-        &'static Rest,
-    ),
-    With<Ball>,
->;
 
 /// Where the drawn balls were (the headless balls have no `PreviousPosition`).
 type DrawnBalls<'w, 's> =
@@ -97,7 +81,7 @@ impl Motion {
 pub fn move_and_contain(
     clock: Res<SimClock>,
     params: Res<SimParams>,
-    balls: MovingBalls,
+    balls: SnapshotBalls,
     drawn: DrawnBalls,
     mut snapshot: ResMut<BallSnapshot>,
     mut log: ResMut<StepLog>,
@@ -179,7 +163,7 @@ impl Arena {
 pub fn damp_velocities(
     clock: Res<SimClock>,
     params: Res<SimParams>,
-    balls: MovingBalls,
+    balls: SnapshotBalls,
     drawn: DrawnBalls,
     mut snapshot: ResMut<BallSnapshot>,
 ) {
@@ -193,74 +177,13 @@ pub fn damp_velocities(
     }
 }
 
-/// Copies every ball into the snapshot, in query order, table by table and in pieces on the
-/// compute pool for many balls; remembers where each drawn ball was, for drawing between
-/// steps.
-fn fill_snapshot(balls: &MovingBalls, mut drawn: DrawnBalls, snapshot: &mut BallSnapshot) {
+/// Remembers where each drawn ball was, for drawing between steps, and copies every ball into
+/// the snapshot.
+fn fill_snapshot(balls: &SnapshotBalls, mut drawn: DrawnBalls, snapshot: &mut BallSnapshot) {
     for (position, mut previous) in &mut drawn {
         previous.0 = position.0;
     }
-    let BallSnapshot {
-        entities,
-        circles,
-        velocities,
-        held,
-        stopped,
-    } = snapshot;
-    // Sized first and then written in place.
-    let count = balls.iter().len();
-    entities.resize(count, Entity::PLACEHOLDER);
-    circles.resize(count, Circle::new(DVec2::ZERO, 0.0));
-    velocities.resize(count, DVec2::ZERO);
-    held.resize(count, false);
-    stopped.clear();
-    stopped.resize(count, false);
-    let Ok(tables) = balls.contiguous_iter() else {
-        // Not stored in tables: one ball at a time.
-        for (k, (ball, position, velocity, radius, rest)) in balls.iter().enumerate() {
-            entities[k] = ball;
-            circles[k] = Circle::new(position.0, radius.0);
-            (velocities[k], held[k]) = (velocity.0, rest.is_held());
-        }
-        return;
-    };
-    let parallel = worth_splitting(count);
-    // Each table fills the next part of the arrays.
-    let (mut places, mut circles, mut velocities, mut held) = (
-        &mut entities[..],
-        &mut circles[..],
-        &mut velocities[..],
-        &mut held[..],
-    );
-    for table in tables {
-        let len = table.0.len();
-        let out = take_front(&mut places, len)
-            .chunks_mut(BALLS_PER_PIECE)
-            .zip(take_front(&mut circles, len).chunks_mut(BALLS_PER_PIECE))
-            .zip(take_front(&mut velocities, len).chunks_mut(BALLS_PER_PIECE))
-            .zip(take_front(&mut held, len).chunks_mut(BALLS_PER_PIECE));
-        let (ball, position, velocity, radius, rest) = table;
-        let from = ball
-            .chunks(BALLS_PER_PIECE)
-            .zip(position.chunks(BALLS_PER_PIECE))
-            .zip(velocity.chunks(BALLS_PER_PIECE))
-            .zip(radius.chunks(BALLS_PER_PIECE))
-            .zip(rest.chunks(BALLS_PER_PIECE));
-        in_pieces(out.zip(from), parallel, |(out, from)| {
-            let (((places, circles), velocities), held) = out;
-            let ((((balls, positions), ball_velocities), radii), rests) = from;
-            places.copy_from_slice(balls);
-            for ((circle, position), radius) in circles.iter_mut().zip(positions).zip(radii) {
-                *circle = Circle::new(position.0, radius.0);
-            }
-            for (velocity, ball_velocity) in velocities.iter_mut().zip(ball_velocities) {
-                *velocity = ball_velocity.0;
-            }
-            for (held, rest) in held.iter_mut().zip(rests) {
-                *held = rest.is_held();
-            }
-        });
-    }
+    snapshot.fill(balls);
 }
 
 #[cfg(test)]
