@@ -24,7 +24,7 @@ use crate::sim::{BroadPhase, CollisionMode, SceneFile};
 
 /// Largest step count accepted by `run`.
 const MAX_STEPS: u64 = 100_000_000;
-/// Most worker threads accepted.
+/// Most threads at work on a step accepted.
 const MAX_THREADS: u64 = 256;
 /// Largest ball count the bench accepts.
 const MAX_BENCH_BALLS: u64 = MAX_BALLS as u64;

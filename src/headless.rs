@@ -56,8 +56,8 @@ pub fn counters_only(app: &mut App) {
 /// This host's choice, not the simulation's: every schedule of the headless app runs its
 /// systems on the calling thread. A headless frame has a handful of systems, and waking
 /// worker threads for them costs more than they take: 0.26 against 0.14 ms a step for the
-/// 1,000-ball discrete gas (measured in one run). The stages' own parallel parts (the grid
-/// search in bands) still use the compute pool.
+/// 1,000-ball discrete gas (measured in one run). The stages' own parallel parts (every pass
+/// over the balls, from 20,000 balls up) still use the compute pool.
 fn run_on_this_thread(app: &mut App) {
     for (_, schedule) in app.world_mut().resource_mut::<Schedules>().iter_mut() {
         schedule.set_executor(SingleThreadedExecutor::default());

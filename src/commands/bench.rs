@@ -60,7 +60,7 @@ pub struct CaseResult {
     pub peak_rss_mib: Option<f64>,
 }
 
-/// Runs `case` in this process with `threads` worker threads.
+/// Runs `case` in this process with `threads` threads at work on each step.
 pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn Error>> {
     let mut scene = SceneFile::parse(STANDARD_GAS, "gas.ron")?;
     if let Some(generate) = scene.generate.as_mut() {

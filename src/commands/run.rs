@@ -127,19 +127,19 @@ pub fn run_scene(setup: &SceneSetup, steps: u64, dt: f64) -> (App, RunReport) {
     run_scene_with_threads(setup, steps, dt, None)
 }
 
-/// [`run_scene`] with the compute pool set to `compute_threads` threads (see
+/// [`run_scene`] with `threads` threads at work on each step (see
 /// [`headless_app_with_threads`]).
 pub fn run_scene_with_threads(
     setup: &SceneSetup,
     steps: u64,
     dt: f64,
-    compute_threads: Option<usize>,
+    threads: Option<usize>,
 ) -> (App, RunReport) {
     run_scene_showing(
         setup,
         steps,
         dt,
-        compute_threads,
+        threads,
         &Progress::hidden(),
         &mut Observers::none(),
     )
@@ -151,11 +151,11 @@ pub fn run_scene_showing(
     setup: &SceneSetup,
     steps: u64,
     dt: f64,
-    compute_threads: Option<usize>,
+    threads: Option<usize>,
     progress: &Progress,
     observers: &mut Observers,
 ) -> (App, RunReport) {
-    let mut app = headless_app_with_threads(dt, compute_threads);
+    let mut app = headless_app_with_threads(dt, threads);
     counters_only(&mut app);
     setup.apply(app.world_mut());
     let start = StateSummary::measure(app.world_mut());

@@ -126,14 +126,6 @@ pub struct BallSnapshot {
 }
 
 impl BallSnapshot {
-    pub fn clear(&mut self) {
-        self.entities.clear();
-        self.circles.clear();
-        self.velocities.clear();
-        self.held.clear();
-        self.stopped.clear();
-    }
-
     /// Whether every ball is held still: the mode's stages then have nothing to do.
     pub fn all_held(&self) -> bool {
         self.held.iter().all(|&held| held)
@@ -265,6 +257,42 @@ pub fn write_back(
     for (index, &entity) in entities.iter().enumerate().skip(written) {
         if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity) {
             (position.0, velocity.0) = (circles[index].center, velocities[index]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::ecs::system::SystemState;
+
+    use super::*;
+
+    #[test]
+    fn balls_written_back_in_another_order_than_the_query_s_are_found_by_entity() {
+        let mut world = World::new();
+        let at_rest = |k: u32| BallState {
+            position: DVec2::new(-(k as f64), 0.0),
+            velocity: DVec2::ZERO,
+            radius: 1.0,
+        };
+        let spawned: Vec<Entity> = (0..5)
+            .map(|k| world.spawn(ball_bundle(BallId(k), at_rest(k))).id())
+            .collect();
+        // The snapshot's order the reverse of the table's: nothing matches by place.
+        let entities: Vec<Entity> = spawned.iter().rev().copied().collect();
+        let circles: Vec<Circle> = (0..5)
+            .map(|k| Circle::new(DVec2::new(k as f64, 10.0), 1.0))
+            .collect();
+        let velocities: Vec<DVec2> = (0..5).map(|k| DVec2::new(0.0, k as f64)).collect();
+        let mut state: SystemState<WrittenBalls> = SystemState::new(&mut world);
+        let mut balls = state.get_mut(&mut world).expect("the balls' query");
+        write_back(&entities, (&circles, &velocities), &mut balls);
+        for (index, &entity) in entities.iter().enumerate() {
+            assert_eq!(
+                world.get::<Position>(entity).unwrap().0,
+                circles[index].center
+            );
+            assert_eq!(world.get::<Velocity>(entity).unwrap().0, velocities[index]);
         }
     }
 }

@@ -9,11 +9,12 @@
 //!   is a parabola under gravity that the timeline follows impact by impact.
 //!
 //! Damping is one factor a step in both; [`Motion`] says why only the continuous mode's
-//! flight is exact. Balls that rest or sleep ([`Rest::is_held`]) are not moved here: the
+//! flight is exact. Balls that rest or sleep ([`Rest::is_held`](super::ball::Rest::is_held)) are not moved here: the
 //! resting stage moves the resting ones, nothing the sleeping ones. A ball meeting a wall
 //! slower than the resting speed stops against it instead of bouncing.
 //!
-//! The discrete mode's pass runs in pieces on the compute pool for many balls ([`parallel`](super::parallel)).
+//! Copying the balls in, and the discrete mode's move and walls, run in pieces on the compute
+//! pool for many balls ([`parallel`](super::parallel)).
 //!
 //! Runs in [`SimSystems::Movement`](super::SimSystems::Movement).
 
@@ -25,7 +26,7 @@ use super::clock::SimClock;
 use super::geometry::Circle;
 use super::geometry::wall::contain_chosen;
 use super::params::{MassModel, SimParams};
-use super::report::{Hit, StepLog};
+use super::report::{StepLog, record_walls_met};
 use super::resting::rest_speed;
 
 /// Where the drawn balls were (the headless balls have no `PreviousPosition`).
@@ -109,7 +110,8 @@ pub fn move_and_contain(
 pub struct Arena {
     half: DVec2,
     restitution: f64,
-    rest_speed: f64,
+    /// Pixels per second: slower, a ball stops against a wall.
+    pub rest_speed: f64,
     mass_model: MassModel,
     /// When the hits are reported to have happened, seconds into the step.
     step_end: f64,
@@ -141,20 +143,17 @@ impl Arena {
             None => (center, velocity),
         };
         let arena = (self.half, self.restitution, self.rest_speed);
-        let at_walls = contain_chosen((&mut *balls.0, &mut *balls.1), chosen, moved, arena);
+        let met = contain_chosen((&mut *balls.0, &mut *balls.1), chosen, moved, arena);
         // The hits and resting impulses in the balls' order, as if found one by one.
-        for (index, contained) in at_walls {
-            let mass = self.mass_model.mass(balls.0[index as usize].radius);
-            log.resting_wall_impulse += contained.resting_impulse(mass);
-            log.hits.extend(Hit::walls_of(
-                index,
-                &contained,
-                self.step_end,
-                self.half,
-                self.restitution,
-                mass,
-            ));
-        }
+        let StepLog {
+            hits,
+            resting_wall_impulse,
+            ..
+        } = log;
+        let recording = (self.half, self.restitution, self.mass_model, self.step_end);
+        record_walls_met(met, balls.0, recording, resting_wall_impulse, |hit| {
+            hits.push(hit)
+        });
     }
 }
 

@@ -3,6 +3,8 @@
 //! one thread, their results joined in the pieces' order. So every result, down to the
 //! rounding of a sum, is the same whatever the thread count.
 
+use std::ops::Range;
+
 use bevy::tasks::{ComputeTaskPool, TaskPool};
 
 /// Below this many balls a stage's work runs on the calling thread: splitting it costs more
@@ -12,6 +14,12 @@ pub const PARALLEL_MIN_BALLS: usize = 20_000;
 /// Balls in each piece of a pass over every ball: big enough that a piece outweighs handing
 /// it to a thread, small enough for 16 threads to share 100,000 balls.
 pub const BALLS_PER_PIECE: usize = 4096;
+
+/// The balls `0..count` in pieces of [`BALLS_PER_PIECE`].
+pub fn piece_ranges(count: usize) -> impl Iterator<Item = Range<usize>> + Clone {
+    (0..count.div_ceil(BALLS_PER_PIECE))
+        .map(move |piece| piece * BALLS_PER_PIECE..((piece + 1) * BALLS_PER_PIECE).min(count))
+}
 
 /// The compute pool the parallel parts run on.
 pub fn compute_pool() -> &'static TaskPool {
@@ -49,10 +57,11 @@ pub fn in_pieces<P: Send, R: Send + 'static>(
 }
 
 /// The parts of `items` in `ranges`, which must be in order and not overlap (gaps between
-/// them are left out): disjoint slices that can go to different threads.
+/// them are left out): disjoint slices that can go to different threads. Panics if a range
+/// starts before the last one ended or ends past `items`.
 pub fn carve<T>(
     mut items: &mut [T],
-    ranges: impl Iterator<Item = std::ops::Range<usize>>,
+    ranges: impl Iterator<Item = Range<usize>>,
 ) -> impl Iterator<Item = &mut [T]> {
     let mut taken = 0;
     ranges.map(move |range| {
@@ -62,7 +71,7 @@ pub fn carve<T>(
     })
 }
 
-/// The first `len` of `items`, which keeps the rest.
+/// The first `len` of `items`, which keeps the rest. Panics if `items` is shorter.
 pub fn take_front<'a, T>(items: &mut &'a mut [T], len: usize) -> &'a mut [T] {
     let (front, rest) = std::mem::take(items).split_at_mut(len);
     *items = rest;

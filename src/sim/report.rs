@@ -13,11 +13,12 @@ use super::ball::BallSnapshot;
 #[cfg(debug_assertions)]
 use super::ball::{Ball, Position, Velocity};
 use super::clock::SimClock;
-use super::geometry::circle::ContactGeometry;
+use super::geometry::circle::{Circle, ContactGeometry};
 use super::geometry::impulse::{Exchange, wall_impulse};
 use super::geometry::wall::{Contained, Wall, wall_contact_point};
 use super::measure::SimStats;
 use super::messages::{BallCollision, WallCollision};
+use super::params::MassModel;
 
 /// A hit a stage handled. Times are seconds into the step; indices are places in this step's
 /// [`BallSnapshot`] (or in the arrays given to the continuous timeline).
@@ -83,6 +84,26 @@ impl Hit {
                 impulse: wall_impulse(mass, restitution, hit.normal_speed),
                 normal_speed: hit.normal_speed,
             })
+    }
+}
+
+/// Records how the balls in `met` (by index, in index order, each with its containment) met
+/// the walls of the arena `[-half, half]` at `time` into the step: each hit handed to
+/// `on_hit`, and each ball's resting impulse added in turn to `resting_impulse`. A ball's mass
+/// comes from its radius in `circles`.
+pub fn record_walls_met(
+    met: Vec<(u32, Contained)>,
+    circles: &[Circle],
+    (half, restitution, mass_model, time): (DVec2, f64, MassModel, f64),
+    resting_impulse: &mut f64,
+    mut on_hit: impl FnMut(Hit),
+) {
+    for (index, contained) in met {
+        let mass = mass_model.mass(circles[index as usize].radius);
+        *resting_impulse += contained.resting_impulse(mass);
+        for hit in Hit::walls_of(index, &contained, time, half, restitution, mass) {
+            on_hit(hit);
+        }
     }
 }
 

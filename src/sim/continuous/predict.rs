@@ -42,14 +42,8 @@ impl Timeline {
         // From here on every ball is known by its slot in the grid's cell order.
         self.grid.renumber_by_slot(&mut self.order);
         // Each ball on the timeline, and its first wall impact, in pieces of slots on the
-        // compute pool for many balls.
-        let still = Mover::new(
-            Circle::new(DVec2::ZERO, 0.0),
-            DVec2::ZERO,
-            DVec2::ZERO,
-            true,
-        );
-        self.movers.resize(self.order.len(), still);
+        // compute pool for many balls (every mover is written: resizing only sizes them).
+        self.movers.resize(self.order.len(), Mover::default());
         let (grid, order) = (&self.grid, &self.order);
         let pieces = self
             .movers

@@ -59,7 +59,7 @@ impl StepSpec {
 /// along it, with gravity's push into the wall taken away; one that is `still` (held by the
 /// resting stage, or stopped on a ball that holds still) does not move at all until a hit
 /// sets it flying: its `velocity` is then only what it will have at the end of the step.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Mover {
     pub center: DVec2,
     pub velocity: DVec2,

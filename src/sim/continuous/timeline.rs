@@ -23,7 +23,7 @@ use crate::sim::geometry::pairs::find_contacts;
 use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_chosen};
 use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 use crate::sim::params::BroadPhase;
-use crate::sim::report::Hit;
+use crate::sim::report::{Hit, record_walls_met};
 
 impl Timeline {
     /// The response stage's part: handles the predicted impacts in time order, predicting
@@ -353,22 +353,10 @@ fn contain_at_the_end(
     on_hit: &mut impl FnMut(Hit),
 ) -> f64 {
     let arena = (spec.half, spec.restitution, spec.rest_speed);
-    let at_walls = contain_chosen((circles, velocities), |_| true, |c, v| (c, v), arena);
+    let met = contain_chosen((circles, velocities), |_| true, |c, v| (c, v), arena);
     let mut resting_impulse = 0.0;
-    for (index, contained) in at_walls {
-        let mass = spec.mass_model.mass(circles[index as usize].radius);
-        resting_impulse += contained.resting_impulse(mass);
-        for hit in Hit::walls_of(
-            index,
-            &contained,
-            spec.dt,
-            spec.half,
-            spec.restitution,
-            mass,
-        ) {
-            on_hit(hit);
-        }
-    }
+    let recording = (spec.half, spec.restitution, spec.mass_model, spec.dt);
+    record_walls_met(met, circles, recording, &mut resting_impulse, on_hit);
     resting_impulse
 }
 

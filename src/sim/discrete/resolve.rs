@@ -7,9 +7,9 @@
 //! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then contains
 //! the balls in a contact in the arena again and writes every ball (the movement stage moved
 //! them in the snapshot) back to its components, both in pieces on the compute pool for many
-//! balls.
-//! Records each exchange and wall hit in the [`StepLog`]. The resting rule applies to pairs
-//! and walls alike (see [`resolve_overlaps`]); pairs of resting balls are the resting stage's.
+//! balls. Records each exchange and wall hit in the [`StepLog`]. The resting rule applies to
+//! pairs and walls alike (see [`resolve_overlaps`]); pairs of resting balls are the resting
+//! stage's.
 
 use bevy::prelude::*;
 
@@ -20,7 +20,6 @@ use crate::sim::geometry::impulse::resolve_overlaps;
 use crate::sim::movement::Arena;
 use crate::sim::params::SimParams;
 use crate::sim::report::{Hit, StepLog};
-use crate::sim::resting::rest_speed;
 
 pub fn resolve_contacts(
     clock: Res<SimClock>,
@@ -43,8 +42,8 @@ pub fn resolve_contacts(
     } = &mut *snapshot;
     in_contact.clear();
     in_contact.resize(entities.len(), false);
-    let rest_speed = rest_speed(&params, clock.dt);
-    let constants = (params.mass_model, params.restitution, rest_speed);
+    let arena = Arena::new(&params, clock.dt);
+    let constants = (params.mass_model, params.restitution, arena.rest_speed);
     // Discrete mode sees a hit only at the end of the step, as an overlap.
     let step_end = clock.dt;
     let log = &mut *log;
@@ -65,7 +64,6 @@ pub fn resolve_contacts(
     );
     // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
     // the movement stage kept every ball inside, so only they need the walls again.
-    let arena = Arena::new(&params, clock.dt);
     arena.contain((circles, velocities), |index| in_contact[index], None, log);
     // Every ball: the movement stage moved them in the snapshot only.
     write_back(entities, (circles, velocities), &mut balls);

@@ -17,7 +17,7 @@ pub struct IndexedContact {
     pub geometry: ContactGeometry,
 }
 
-/// Bands of rows per worker thread, so an unlucky band does not leave a thread idle.
+/// Bands of rows per thread at work, so an unlucky band does not leave a thread idle.
 const BANDS_PER_THREAD: usize = 4;
 
 /// Finds every touching pair among `circles` and appends it to `found`, each pair once with

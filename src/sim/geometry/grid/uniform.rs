@@ -13,7 +13,9 @@ use super::cells::CellMap;
 use super::counting::{NO_CELL, sort_into_cells};
 use super::rows::RowLists;
 use crate::sim::geometry::circle::Circle;
-use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, threads_at_work, worth_splitting};
+use crate::sim::parallel::{
+    BALLS_PER_PIECE, in_pieces, piece_ranges, threads_at_work, worth_splitting,
+};
 
 /// A ball whose radius is more than this many times the mean radius is big: see the header.
 const BIG_RADIUS_FACTOR: f64 = 4.0;
@@ -63,18 +65,13 @@ impl UniformGrid {
     /// [`rebuild`](Self::rebuild) with the `count` circles made by `circle_at(index)` (each
     /// made a few times), for a caller that would otherwise keep a copy of them only to sort.
     pub fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle + Sync) {
-        // Every pass over the balls runs in pieces, on the compute pool for many balls.
-        let parallel = worth_splitting(count);
-        let pieces = || {
-            (0..count.div_ceil(BALLS_PER_PIECE))
-                .map(|piece| piece * BALLS_PER_PIECE..((piece + 1) * BALLS_PER_PIECE).min(count))
-        };
-        let radius_sums = in_pieces(pieces(), parallel, |balls| {
-            balls.map(|ball| circle_at(ball).radius).sum::<f64>()
-        });
-        self.big_limit = BIG_RADIUS_FACTOR * radius_sums.iter().sum::<f64>() / count.max(1) as f64;
+        // One sum in the balls' order, so the mean's rounding never depends on how the work
+        // is cut; every other pass over the balls runs in pieces, on the compute pool for many.
+        let radius_sum: f64 = (0..count).map(|ball| circle_at(ball).radius).sum();
+        self.big_limit = BIG_RADIUS_FACTOR * radius_sum / count.max(1) as f64;
         let big_limit = self.big_limit;
-        let bounds = in_pieces(pieces(), parallel, |balls| {
+        let parallel = worth_splitting(count);
+        let bounds = in_pieces(piece_ranges(count), parallel, |balls| {
             let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
             for circle in balls.map(&circle_at) {
                 min = min.min(circle.center);
@@ -98,7 +95,10 @@ impl UniformGrid {
         // Every entry of the buffers below is written before it is read: resizing them only
         // fills what they gained since the last step.
         self.cell_of.resize(count, NO_CELL);
-        let cell_pieces = self.cell_of.chunks_mut(BALLS_PER_PIECE).zip(pieces());
+        let cell_pieces = self
+            .cell_of
+            .chunks_mut(BALLS_PER_PIECE)
+            .zip(piece_ranges(count));
         in_pieces(cell_pieces, parallel, |(cell_of, balls)| {
             for (cell, circle) in cell_of.iter_mut().zip(balls.map(&circle_at)) {
                 *cell = if is_big(circle.radius, big_limit) {
