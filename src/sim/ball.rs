@@ -134,6 +134,17 @@ impl BallSnapshot {
     /// Copies every ball into the snapshot, in query order, table by table and in pieces on
     /// the compute pool for many balls.
     pub fn fill(&mut self, balls: &SnapshotBalls) {
+        self.fill_then(balls, |_, _| ());
+    }
+
+    /// [`fill`](Self::fill), then `then(first, piece)` on each piece of balls just copied, while
+    /// it is in the cache (`first` is the index of its first ball); the results in the balls'
+    /// order.
+    pub fn fill_then<R: Send + 'static>(
+        &mut self,
+        balls: &SnapshotBalls,
+        then: impl Fn(usize, Piece) -> R + Sync,
+    ) -> Vec<R> {
         let BallSnapshot {
             entities,
             circles,
@@ -150,15 +161,16 @@ impl BallSnapshot {
         stopped.clear();
         stopped.resize(count, false);
         let Ok(tables) = balls.contiguous_iter() else {
-            // Not stored in tables: one ball at a time.
+            // Not stored in tables: one ball at a time, then all as one piece.
             for (k, (ball, position, velocity, radius, rest)) in balls.iter().enumerate() {
                 entities[k] = ball;
                 circles[k] = Circle::new(position.0, radius.0);
                 (velocities[k], held[k]) = (velocity.0, rest.is_held());
             }
-            return;
+            return vec![then(0, (circles, velocities, held))];
         };
         let parallel = worth_splitting(count);
+        let mut results = Vec::new();
         // Each table fills the next part of the arrays.
         let (mut places, mut circles, mut velocities, mut held) = (
             &mut entities[..],
@@ -166,6 +178,7 @@ impl BallSnapshot {
             &mut velocities[..],
             &mut held[..],
         );
+        let mut first = 0;
         for table in tables {
             let len = table.0.len();
             let out = take_front(&mut places, len)
@@ -180,23 +193,38 @@ impl BallSnapshot {
                 .zip(velocity.chunks(BALLS_PER_PIECE))
                 .zip(radius.chunks(BALLS_PER_PIECE))
                 .zip(rest.chunks(BALLS_PER_PIECE));
-            in_pieces(out.zip(from), parallel, |(out, from)| {
-                let (((places, circles), velocities), held) = out;
-                let ((((balls, positions), ball_velocities), radii), rests) = from;
-                places.copy_from_slice(balls);
-                for ((circle, position), radius) in circles.iter_mut().zip(positions).zip(radii) {
-                    *circle = Circle::new(position.0, radius.0);
-                }
-                for (velocity, ball_velocity) in velocities.iter_mut().zip(ball_velocities) {
-                    *velocity = ball_velocity.0;
-                }
-                for (held, rest) in held.iter_mut().zip(rests) {
-                    *held = rest.is_held();
-                }
-            });
+            let table_first = first;
+            results.extend(in_pieces(
+                out.zip(from).enumerate(),
+                parallel,
+                |(k, (out, from))| {
+                    let (((places, circles), velocities), held) = out;
+                    let ((((balls, positions), ball_velocities), radii), rests) = from;
+                    places.copy_from_slice(balls);
+                    for ((circle, position), radius) in circles.iter_mut().zip(positions).zip(radii)
+                    {
+                        *circle = Circle::new(position.0, radius.0);
+                    }
+                    for (velocity, ball_velocity) in velocities.iter_mut().zip(ball_velocities) {
+                        *velocity = ball_velocity.0;
+                    }
+                    for (held, rest) in held.iter_mut().zip(rests) {
+                        *held = rest.is_held();
+                    }
+                    then(
+                        table_first + k * BALLS_PER_PIECE,
+                        (circles, velocities, held),
+                    )
+                },
+            ));
+            first += len;
         }
+        results
     }
 }
+
+/// Part of the snapshot's balls, as [`BallSnapshot::fill_then`] hands it on.
+pub type Piece<'a> = (&'a mut [Circle], &'a mut [DVec2], &'a mut [bool]);
 
 /// The balls as the movement stage copies them into the snapshot.
 pub type SnapshotBalls<'w, 's> = Query<
@@ -223,11 +251,24 @@ pub type WrittenBalls<'w, 's> =
 /// order ever not match, the rest are looked up by entity.
 pub fn write_back(
     entities: &[Entity],
-    (circles, velocities): (&[Circle], &[DVec2]),
+    (circles, velocities): (&mut [Circle], &mut [DVec2]),
     balls: &mut WrittenBalls,
 ) {
+    write_back_after(entities, (circles, velocities), balls, |_, _| ());
+}
+
+/// [`write_back`], with `before(first, piece)` done to each piece of balls just before it is
+/// written (`first` is the index of its first ball); the results in the balls' order.
+pub fn write_back_after<R: Send + 'static>(
+    entities: &[Entity],
+    (circles, velocities): (&mut [Circle], &mut [DVec2]),
+    balls: &mut WrittenBalls,
+    before: impl Fn(usize, (&mut [Circle], &mut [DVec2])) -> R + Sync,
+) -> Vec<R> {
     let parallel = worth_splitting(entities.len());
+    let mut results = Vec::new();
     let mut written = 0;
+    let (mut rest_circles, mut rest_velocities) = (&mut circles[..], &mut velocities[..]);
     if let Ok(tables) = balls.contiguous_iter_mut() {
         for (table_entities, mut positions, mut table_velocities) in tables {
             let places = written..written + table_entities.len();
@@ -237,28 +278,31 @@ pub fn write_back(
             let pieces = positions
                 .chunks_mut(BALLS_PER_PIECE)
                 .zip(table_velocities.chunks_mut(BALLS_PER_PIECE))
-                .zip(circles[places.clone()].chunks(BALLS_PER_PIECE))
-                .zip(velocities[places.clone()].chunks(BALLS_PER_PIECE));
-            in_pieces(
-                pieces,
-                parallel,
-                |(((positions, out), circles), velocities)| {
-                    for (position, circle) in positions.iter_mut().zip(circles) {
-                        position.0 = circle.center;
-                    }
-                    for (velocity, &new) in out.iter_mut().zip(velocities) {
-                        velocity.0 = new;
-                    }
-                },
-            );
+                .zip(take_front(&mut rest_circles, places.len()).chunks_mut(BALLS_PER_PIECE))
+                .zip(take_front(&mut rest_velocities, places.len()).chunks_mut(BALLS_PER_PIECE));
+            results.extend(in_pieces(pieces.enumerate(), parallel, |(k, balls)| {
+                let (((positions, ball_velocities), circles), velocities) = balls;
+                let result = before(places.start + k * BALLS_PER_PIECE, (circles, velocities));
+                for (position, circle) in positions.iter_mut().zip(circles.iter()) {
+                    position.0 = circle.center;
+                }
+                for (velocity, &new) in ball_velocities.iter_mut().zip(velocities.iter()) {
+                    velocity.0 = new;
+                }
+                result
+            }));
             written = places.end;
         }
     }
-    for (index, &entity) in entities.iter().enumerate().skip(written) {
-        if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity) {
-            (position.0, velocity.0) = (circles[index].center, velocities[index]);
+    if written < entities.len() {
+        results.push(before(written, (rest_circles, rest_velocities)));
+        for (index, &entity) in entities.iter().enumerate().skip(written) {
+            if let Ok((_, mut position, mut velocity)) = balls.get_mut(entity) {
+                (position.0, velocity.0) = (circles[index].center, velocities[index]);
+            }
         }
     }
+    results
 }
 
 #[cfg(test)]
@@ -280,13 +324,13 @@ mod tests {
             .collect();
         // The snapshot's order the reverse of the table's: nothing matches by place.
         let entities: Vec<Entity> = spawned.iter().rev().copied().collect();
-        let circles: Vec<Circle> = (0..5)
+        let mut circles: Vec<Circle> = (0..5)
             .map(|k| Circle::new(DVec2::new(k as f64, 10.0), 1.0))
             .collect();
-        let velocities: Vec<DVec2> = (0..5).map(|k| DVec2::new(0.0, k as f64)).collect();
+        let mut velocities: Vec<DVec2> = (0..5).map(|k| DVec2::new(0.0, k as f64)).collect();
         let mut state: SystemState<WrittenBalls> = SystemState::new(&mut world);
         let mut balls = state.get_mut(&mut world).expect("the balls' query");
-        write_back(&entities, (&circles, &velocities), &mut balls);
+        write_back(&entities, (&mut circles, &mut velocities), &mut balls);
         for (index, &entity) in entities.iter().enumerate() {
             assert_eq!(
                 world.get::<Position>(entity).unwrap().0,

@@ -24,7 +24,7 @@ use bevy::prelude::*;
 use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, SnapshotBalls};
 use super::clock::SimClock;
 use super::geometry::Circle;
-use super::geometry::wall::contain_chosen;
+use super::geometry::wall::{Contained, contain_piece};
 use super::params::{MassModel, SimParams};
 use super::report::{StepLog, record_walls_met};
 use super::resting::rest_speed;
@@ -78,31 +78,24 @@ impl Motion {
 }
 
 /// Discrete mode: moves every ball over the step and contains it in the arena, in the
-/// snapshot, recording its wall hits. The balls are written back by the response.
+/// snapshot, each piece of balls as soon as it is copied in; records the wall hits. The balls
+/// are written back by the response.
 pub fn move_and_contain(
     clock: Res<SimClock>,
     params: Res<SimParams>,
     balls: SnapshotBalls,
-    drawn: DrawnBalls,
+    mut drawn: DrawnBalls,
     mut snapshot: ResMut<BallSnapshot>,
     mut log: ResMut<StepLog>,
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
-    let snapshot = &mut *snapshot;
-    fill_snapshot(&balls, drawn, snapshot);
-    let BallSnapshot {
-        circles,
-        velocities,
-        held,
-        ..
-    } = snapshot;
     let arena = Arena::new(&params, clock.dt);
-    arena.contain(
-        (circles, velocities),
-        |index| !held[index],
-        Some(motion),
-        &mut log,
-    );
+    remember_drawn(&mut drawn);
+    let met = snapshot.fill_then(&balls, |first, (circles, velocities, held)| {
+        let free = |index: usize| !held[index - first];
+        arena.contain_piece(first, (circles, velocities), free, Some(motion))
+    });
+    arena.record(met.into_iter().flatten(), &snapshot.circles, &mut log);
 }
 
 /// The arena's walls as the discrete mode meets them at the end of a step.
@@ -128,30 +121,39 @@ impl Arena {
         }
     }
 
-    /// Contains each ball that `chosen(index)` picks in the arena, after moving it by `motion`
-    /// if given, recording its wall hits and resting impulses in `log` in the balls' order.
-    /// In pieces on the compute pool for many balls.
-    pub fn contain(
+    /// Contains each ball of a piece (the first of which has index `first`) that
+    /// `chosen(index)` picks in the arena, after moving it by `motion` if given. Returns the
+    /// balls that met a wall, for [`record`](Self::record).
+    pub fn contain_piece(
         &self,
+        first: usize,
         balls: (&mut [Circle], &mut [DVec2]),
-        chosen: impl Fn(usize) -> bool + Sync,
+        chosen: impl Fn(usize) -> bool,
         motion: Option<Motion>,
-        log: &mut StepLog,
-    ) {
+    ) -> Vec<(u32, Contained)> {
         let moved = |center, velocity| match motion {
             Some(motion) => motion.integrate(center, velocity),
             None => (center, velocity),
         };
         let arena = (self.half, self.restitution, self.rest_speed);
-        let met = contain_chosen((&mut *balls.0, &mut *balls.1), chosen, moved, arena);
-        // The hits and resting impulses in the balls' order, as if found one by one.
+        contain_piece(first, balls, &chosen, &moved, arena)
+    }
+
+    /// Records in `log` the wall hits and resting impulses of the balls in `met`, in the
+    /// balls' order, as if found one by one.
+    pub fn record(
+        &self,
+        met: impl IntoIterator<Item = (u32, Contained)>,
+        circles: &[Circle],
+        log: &mut StepLog,
+    ) {
         let StepLog {
             hits,
             resting_wall_impulse,
             ..
         } = log;
         let recording = (self.half, self.restitution, self.mass_model, self.step_end);
-        record_walls_met(met, balls.0, recording, resting_wall_impulse, |hit| {
+        record_walls_met(met, circles, recording, resting_wall_impulse, |hit| {
             hits.push(hit)
         });
     }
@@ -163,12 +165,13 @@ pub fn damp_velocities(
     clock: Res<SimClock>,
     params: Res<SimParams>,
     balls: SnapshotBalls,
-    drawn: DrawnBalls,
+    mut drawn: DrawnBalls,
     mut snapshot: ResMut<BallSnapshot>,
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
+    remember_drawn(&mut drawn);
     let snapshot = &mut *snapshot;
-    fill_snapshot(&balls, drawn, snapshot);
+    snapshot.fill(&balls);
     for (velocity, &held) in snapshot.velocities.iter_mut().zip(&snapshot.held) {
         if !held {
             *velocity = motion.damped(*velocity);
@@ -176,13 +179,11 @@ pub fn damp_velocities(
     }
 }
 
-/// Remembers where each drawn ball was, for drawing between steps, and copies every ball into
-/// the snapshot.
-fn fill_snapshot(balls: &SnapshotBalls, mut drawn: DrawnBalls, snapshot: &mut BallSnapshot) {
-    for (position, mut previous) in &mut drawn {
+/// Remembers where each drawn ball was, for drawing between steps.
+fn remember_drawn(drawn: &mut DrawnBalls) {
+    for (position, mut previous) in drawn {
         previous.0 = position.0;
     }
-    snapshot.fill(balls);
 }
 
 #[cfg(test)]

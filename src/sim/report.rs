@@ -92,7 +92,7 @@ impl Hit {
 /// `on_hit`, and each ball's resting impulse added in turn to `resting_impulse`. A ball's mass
 /// comes from its radius in `circles`.
 pub fn record_walls_met(
-    met: Vec<(u32, Contained)>,
+    met: impl IntoIterator<Item = (u32, Contained)>,
     circles: &[Circle],
     (half, restitution, mass_model, time): (DVec2, f64, MassModel, f64),
     resting_impulse: &mut f64,

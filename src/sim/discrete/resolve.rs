@@ -14,7 +14,7 @@
 use bevy::prelude::*;
 
 use super::detect::Contacts;
-use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back};
+use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back_after};
 use crate::sim::clock::SimClock;
 use crate::sim::geometry::impulse::resolve_overlaps;
 use crate::sim::movement::Arena;
@@ -62,9 +62,18 @@ pub fn resolve_contacts(
         constants,
         |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange)),
     );
-    // Separation may have pushed a ball into a wall. Only balls in a contact have moved since
-    // the movement stage kept every ball inside, so only they need the walls again.
-    arena.contain((circles, velocities), |index| in_contact[index], None, log);
-    // Every ball: the movement stage moved them in the snapshot only.
-    write_back(entities, (circles, velocities), &mut balls);
+    // Every ball written back (the movement stage moved them in the snapshot only), each piece
+    // after the walls again for its balls in a contact: separation may have pushed them into a
+    // wall, and only they have moved since the movement stage kept every ball inside.
+    let in_contact = &*in_contact;
+    let met = write_back_after(
+        entities,
+        (circles, velocities),
+        &mut balls,
+        |first, piece| {
+            let touched = |index: usize| in_contact[index];
+            arena.contain_piece(first, piece, touched, None)
+        },
+    );
+    arena.record(met.into_iter().flatten(), circles, log);
 }

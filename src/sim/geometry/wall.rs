@@ -142,40 +142,46 @@ pub fn contain_chosen(
     (circles, velocities): (&mut [Circle], &mut [DVec2]),
     chosen: impl Fn(usize) -> bool + Sync,
     moved: impl Fn(DVec2, DVec2) -> (DVec2, DVec2) + Sync,
-    (half, restitution, rest_speed): (DVec2, f64, f64),
+    arena: (DVec2, f64, f64),
 ) -> Vec<(u32, Contained)> {
     let parallel = worth_splitting(circles.len());
     let pieces = circles
         .chunks_mut(BALLS_PER_PIECE)
         .zip(velocities.chunks_mut(BALLS_PER_PIECE));
-    let by_piece = in_pieces(
-        pieces.enumerate(),
-        parallel,
-        |(piece, (circles, velocities))| {
-            let first = piece * BALLS_PER_PIECE;
-            let mut at_walls = Vec::new();
-            for (offset, (circle, velocity)) in circles.iter_mut().zip(velocities).enumerate() {
-                if !chosen(first + offset) {
-                    continue;
-                }
-                let (center, new_velocity) = moved(circle.center, *velocity);
-                let contained = contain_at_rest(
-                    center,
-                    new_velocity,
-                    circle.radius,
-                    half,
-                    restitution,
-                    rest_speed,
-                );
-                (circle.center, *velocity) = (contained.position, contained.velocity);
-                if contained.hits != [None, None] {
-                    at_walls.push(((first + offset) as u32, contained));
-                }
-            }
-            at_walls
-        },
-    );
+    let by_piece = in_pieces(pieces.enumerate(), parallel, |(piece, balls)| {
+        contain_piece(piece * BALLS_PER_PIECE, balls, &chosen, &moved, arena)
+    });
     by_piece.into_iter().flatten().collect()
+}
+
+/// [`contain_chosen`] on one piece of the balls, whose first has index `first`.
+pub fn contain_piece(
+    first: usize,
+    (circles, velocities): (&mut [Circle], &mut [DVec2]),
+    chosen: &impl Fn(usize) -> bool,
+    moved: &impl Fn(DVec2, DVec2) -> (DVec2, DVec2),
+    (half, restitution, rest_speed): (DVec2, f64, f64),
+) -> Vec<(u32, Contained)> {
+    let mut at_walls = Vec::new();
+    for (offset, (circle, velocity)) in circles.iter_mut().zip(velocities).enumerate() {
+        if !chosen(first + offset) {
+            continue;
+        }
+        let (center, new_velocity) = moved(circle.center, *velocity);
+        let contained = contain_at_rest(
+            center,
+            new_velocity,
+            circle.radius,
+            half,
+            restitution,
+            rest_speed,
+        );
+        (circle.center, *velocity) = (contained.position, contained.velocity);
+        if contained.hits != [None, None] {
+            at_walls.push(((first + offset) as u32, contained));
+        }
+    }
+    at_walls
 }
 
 /// Where a ball at `position` touches `wall` of the arena `[-half, half]`.
