@@ -159,8 +159,9 @@ impl Arena {
     }
 }
 
-/// Continuous mode: damps every ball's velocity in the snapshot (the timeline flies the balls
-/// along their parabolas, impact by impact, and writes them back).
+/// Continuous mode: damps every ball's velocity in the snapshot, each piece as soon as it is
+/// copied in (the timeline flies the balls along their parabolas, impact by impact, and
+/// writes them back).
 pub fn damp_velocities(
     clock: Res<SimClock>,
     params: Res<SimParams>,
@@ -170,13 +171,13 @@ pub fn damp_velocities(
 ) {
     let motion = Motion::new(params.gravity, params.linear_damping, clock.dt);
     remember_drawn(&mut drawn);
-    let snapshot = &mut *snapshot;
-    snapshot.fill(&balls);
-    for (velocity, &held) in snapshot.velocities.iter_mut().zip(&snapshot.held) {
-        if !held {
-            *velocity = motion.damped(*velocity);
+    snapshot.fill_then(&balls, |_, (_, velocities, held)| {
+        for (velocity, &held) in velocities.iter_mut().zip(held.iter()) {
+            if !held {
+                *velocity = motion.damped(*velocity);
+            }
         }
-    }
+    });
 }
 
 /// Remembers where each drawn ball was, for drawing between steps.
