@@ -9,7 +9,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::geometry::Circle;
-use super::parallel::{BALLS_PER_PIECE, in_pieces, take_front, worth_splitting};
+use super::parallel::{BALLS_PER_PIECE, in_pieces, piece_ranges, take_front, worth_splitting};
 
 /// Marks a simulated ball; spawning it brings the state components along.
 #[derive(Component, Debug, Default, Clone, Copy)]
@@ -145,81 +145,119 @@ impl BallSnapshot {
         balls: &SnapshotBalls,
         then: impl Fn(usize, Piece) -> R + Sync,
     ) -> Vec<R> {
-        let BallSnapshot {
-            entities,
-            circles,
-            velocities,
-            held,
-            stopped,
-        } = self;
-        // Sized first and then written in place.
         let count = balls.iter().len();
-        entities.resize(count, Entity::PLACEHOLDER);
-        circles.resize(count, Circle::new(DVec2::ZERO, 0.0));
-        velocities.resize(count, DVec2::ZERO);
-        held.resize(count, false);
-        stopped.clear();
-        stopped.resize(count, false);
+        // Sized first and then written in place.
+        let mut rest = self.columns_for(count);
         let Ok(tables) = balls.contiguous_iter() else {
             // Not stored in tables: one ball at a time, then all as one piece.
-            for (k, (ball, position, velocity, radius, rest)) in balls.iter().enumerate() {
-                entities[k] = ball;
-                circles[k] = Circle::new(position.0, radius.0);
-                (velocities[k], held[k]) = (velocity.0, rest.is_held());
+            for (entity, position, velocity, radius, rest_state) in balls {
+                let ball = ([entity], [*position], [*velocity], [*radius], [*rest_state]);
+                rest.take_front(1).copy_from(ball);
             }
-            return vec![then(0, (circles, velocities, held))];
+            let all = (
+                &mut self.circles[..],
+                &mut self.velocities[..],
+                &mut self.held[..],
+            );
+            return vec![then(0, all)];
         };
         let parallel = worth_splitting(count);
         let mut results = Vec::new();
-        // Each table fills the next part of the arrays.
-        let (mut places, mut circles, mut velocities, mut held) = (
-            &mut entities[..],
-            &mut circles[..],
-            &mut velocities[..],
-            &mut held[..],
-        );
         let mut first = 0;
+        // Each table fills the next part of the columns, piece by piece.
         for table in tables {
             let len = table.0.len();
-            let out = take_front(&mut places, len)
-                .chunks_mut(BALLS_PER_PIECE)
-                .zip(take_front(&mut circles, len).chunks_mut(BALLS_PER_PIECE))
-                .zip(take_front(&mut velocities, len).chunks_mut(BALLS_PER_PIECE))
-                .zip(take_front(&mut held, len).chunks_mut(BALLS_PER_PIECE));
-            let (ball, position, velocity, radius, rest) = table;
-            let from = ball
-                .chunks(BALLS_PER_PIECE)
-                .zip(position.chunks(BALLS_PER_PIECE))
-                .zip(velocity.chunks(BALLS_PER_PIECE))
-                .zip(radius.chunks(BALLS_PER_PIECE))
-                .zip(rest.chunks(BALLS_PER_PIECE));
-            let table_first = first;
-            results.extend(in_pieces(
-                out.zip(from).enumerate(),
-                parallel,
-                |(k, (out, from))| {
-                    let (((places, circles), velocities), held) = out;
-                    let ((((balls, positions), ball_velocities), radii), rests) = from;
-                    places.copy_from_slice(balls);
-                    for ((circle, position), radius) in circles.iter_mut().zip(positions).zip(radii)
-                    {
-                        *circle = Circle::new(position.0, radius.0);
-                    }
-                    for (velocity, ball_velocity) in velocities.iter_mut().zip(ball_velocities) {
-                        *velocity = ball_velocity.0;
-                    }
-                    for (held, rest) in held.iter_mut().zip(rests) {
-                        *held = rest.is_held();
-                    }
-                    then(
-                        table_first + k * BALLS_PER_PIECE,
-                        (circles, velocities, held),
-                    )
-                },
-            ));
+            let pieces = rest.take_front(len).into_pieces().zip(piece_ranges(len));
+            results.extend(in_pieces(pieces, parallel, |(mut into, balls)| {
+                let (entities, positions, velocities, radii, rests) = table;
+                into.copy_from((
+                    &entities[balls.clone()],
+                    &positions[balls.clone()],
+                    &velocities[balls.clone()],
+                    &radii[balls.clone()],
+                    &rests[balls.clone()],
+                ));
+                then(
+                    first + balls.start,
+                    (into.circles, into.velocities, into.held),
+                )
+            }));
             first += len;
         }
         results
+    }
+
+    /// The columns sized for `count` balls (what they held is overwritten; `stopped` is
+    /// cleared).
+    fn columns_for(&mut self, count: usize) -> Columns<'_> {
+        self.entities.resize(count, Entity::PLACEHOLDER);
+        self.circles.resize(count, Circle::new(DVec2::ZERO, 0.0));
+        self.velocities.resize(count, DVec2::ZERO);
+        self.held.resize(count, false);
+        self.stopped.clear();
+        self.stopped.resize(count, false);
+        Columns {
+            entities: &mut self.entities,
+            circles: &mut self.circles,
+            velocities: &mut self.velocities,
+            held: &mut self.held,
+        }
+    }
+}
+
+/// The snapshot's columns that [`BallSnapshot::fill_then`] writes, or a part of them.
+struct Columns<'a> {
+    entities: &'a mut [Entity],
+    circles: &'a mut [Circle],
+    velocities: &'a mut [DVec2],
+    held: &'a mut [bool],
+}
+
+impl<'a> Columns<'a> {
+    /// The first `len` balls' columns; these keep the rest.
+    fn take_front(&mut self, len: usize) -> Columns<'a> {
+        Columns {
+            entities: take_front(&mut self.entities, len),
+            circles: take_front(&mut self.circles, len),
+            velocities: take_front(&mut self.velocities, len),
+            held: take_front(&mut self.held, len),
+        }
+    }
+
+    /// In pieces of [`BALLS_PER_PIECE`] balls, as [`piece_ranges`] cuts them.
+    fn into_pieces(mut self) -> impl Iterator<Item = Columns<'a>> {
+        std::iter::from_fn(move || {
+            let len = self.entities.len().min(BALLS_PER_PIECE);
+            (len > 0).then(|| self.take_front(len))
+        })
+    }
+
+    /// Copies in the same number of balls from a table's columns.
+    fn copy_from(
+        &mut self,
+        (entities, positions, velocities, radii, rests): (
+            impl AsRef<[Entity]>,
+            impl AsRef<[Position]>,
+            impl AsRef<[Velocity]>,
+            impl AsRef<[Radius]>,
+            impl AsRef<[Rest]>,
+        ),
+    ) {
+        self.entities.copy_from_slice(entities.as_ref());
+        let places = self
+            .circles
+            .iter_mut()
+            .zip(positions.as_ref())
+            .zip(radii.as_ref());
+        for ((circle, position), radius) in places {
+            *circle = Circle::new(position.0, radius.0);
+        }
+        for (velocity, from) in self.velocities.iter_mut().zip(velocities.as_ref()) {
+            *velocity = from.0;
+        }
+        for (held, rest) in self.held.iter_mut().zip(rests.as_ref()) {
+            *held = rest.is_held();
+        }
     }
 }
 
