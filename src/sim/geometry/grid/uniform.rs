@@ -14,7 +14,7 @@ use super::counting::{NO_CELL, sort_into_cells};
 use super::rows::RowLists;
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
-    BALLS_PER_PIECE, in_pieces, piece_ranges, threads_at_work, worth_splitting,
+    BALLS_PER_PIECE, carve, in_pieces, piece_ranges, threads_at_work, worth_splitting,
 };
 
 /// A ball whose radius is more than this many times the mean radius is big: see the header.
@@ -162,14 +162,28 @@ impl UniformGrid {
         std::mem::swap(order, &mut self.sorted_index);
         self.sorted_index.clear();
         self.sorted_index.extend(0..order.len() as u32);
-        // Each slot's cell, for `reach_from_cell`.
-        self.cell_of.clear();
-        for cell in 0..self.cells.cell_count() {
-            let slots = self.slots_of(cell..cell + 1);
-            self.cell_of
-                .extend(std::iter::repeat_n(cell as u32, slots.len()));
-        }
+        // Each slot's cell, for `reach_from_cell`: in bands of cells, each writing its slots.
         self.cell_of.resize(order.len(), NO_CELL);
+        let cell_count = self.cells.cell_count();
+        let parallel = worth_splitting(order.len());
+        let bands = if parallel { 4 * threads_at_work() } else { 1 };
+        let band_cells = |band: usize| cell_count * band / bands..cell_count * (band + 1) / bands;
+        let starts = &self.cell_start;
+        let band_slots = (0..bands).map(|band| {
+            let cells = band_cells(band);
+            starts[cells.start] as usize..starts[cells.end] as usize
+        });
+        let work = (0..bands)
+            .map(band_cells)
+            .zip(carve(&mut self.cell_of, band_slots));
+        in_pieces(work, parallel, |(cells, slots)| {
+            let first = starts[cells.start] as usize;
+            for cell in cells {
+                let (start, end) = (starts[cell] as usize, starts[cell + 1] as usize);
+                slots[start - first..end - first].fill(cell as u32);
+            }
+        });
+        self.cell_of[self.small_count..].fill(NO_CELL);
     }
 
     /// The circle of the ball in `slot`.
