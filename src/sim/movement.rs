@@ -9,12 +9,13 @@
 //!   is a parabola under gravity that the timeline follows impact by impact.
 //!
 //! Damping is one factor a step in both; [`Motion`] says why only the continuous mode's
-//! flight is exact. Balls that rest or sleep ([`Rest::is_held`](super::ball::Rest::is_held)) are not moved here: the
-//! resting stage moves the resting ones, nothing the sleeping ones. A ball meeting a wall
-//! slower than the resting speed stops against it instead of bouncing.
+//! flight is exact. Balls that rest or sleep ([`Rest::is_held`](super::ball::Rest::is_held))
+//! are not moved here: the resting stage moves the resting ones, nothing the sleeping ones. A
+//! ball meeting a wall slower than the resting speed stops against it instead of bouncing.
 //!
-//! Copying the balls in, and the discrete mode's move and walls, run in pieces on the compute
-//! pool for many balls ([`parallel`](super::parallel)).
+//! Both run in pieces on the compute pool for many balls ([`parallel`](super::parallel)), each
+//! piece moved as soon as it is copied in. [`Arena`] holds the walls as the discrete mode
+//! meets them; its response uses it again after pushing balls apart.
 //!
 //! Runs in [`SimSystems::Movement`](super::SimSystems::Movement).
 
