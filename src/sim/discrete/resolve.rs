@@ -8,7 +8,7 @@
 //! the balls in a contact in the arena again and writes every ball (the movement stage moved
 //! them in the snapshot) back to its components, both in pieces on the compute pool for many
 //! balls. Records each exchange and wall hit in the [`StepLog`]. The resting rule applies to
-//! pairs and walls alike (see [`resolve_overlaps`]); pairs of resting balls are the resting
+//! pairs and walls alike (see [`resolve_overlaps`](crate::sim::geometry::impulse::resolve_overlaps)); pairs of resting balls are the resting
 //! stage's.
 
 use bevy::prelude::*;
@@ -16,7 +16,7 @@ use bevy::prelude::*;
 use super::detect::Contacts;
 use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back_after};
 use crate::sim::clock::SimClock;
-use crate::sim::geometry::impulse::resolve_overlaps;
+use crate::sim::geometry::impulse::resolve_found_contacts;
 use crate::sim::movement::Arena;
 use crate::sim::params::SimParams;
 use crate::sim::report::{Hit, StepLog};
@@ -48,14 +48,10 @@ pub fn resolve_contacts(
     let step_end = clock.dt;
     let log = &mut *log;
     let hits = &mut log.hits;
-    // Each pair's balls marked as it is taken, while they are in the cache.
-    let pairs = contacts.0.iter().map(|contact| {
-        let (a, b) = (contact.a, contact.b);
-        (in_contact[a as usize], in_contact[b as usize]) = (true, true);
-        (a, b)
-    });
-    resolve_overlaps(
-        pairs,
+    // Each contact's balls marked as it is taken, while they are in the cache.
+    resolve_found_contacts(
+        &contacts.0,
+        &mut in_contact,
         circles,
         velocities,
         held,

@@ -10,6 +10,7 @@
 use bevy::math::DVec2;
 
 use super::circle::{Circle, ContactGeometry, circle_contact};
+use super::pairs::IndexedContact;
 use crate::sim::params::MassModel;
 
 /// The result of [`normal_exchange`]: the new velocities and what the hit carried.
@@ -98,16 +99,52 @@ pub fn resolve_overlaps(
     circles: &mut [Circle],
     velocities: &mut [DVec2],
     held: &mut [bool],
+    constants: (MassModel, f64, f64),
+    on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
+) {
+    let pairs = pairs.into_iter().map(|(a, b)| (a, b, None));
+    resolve_known_overlaps(pairs, circles, velocities, held, constants, on_exchange);
+}
+
+/// [`resolve_overlaps`] for `contacts` as [`find_contacts`](super::pairs::find_contacts) found
+/// them, marking in `touched` the balls of each as it is taken. A contact neither of whose
+/// balls an earlier one touched is still where it was found, so its geometry is used as found:
+/// the same result, without working it out again.
+pub fn resolve_found_contacts(
+    contacts: &[IndexedContact],
+    touched: &mut [bool],
+    circles: &mut [Circle],
+    velocities: &mut [DVec2],
+    held: &mut [bool],
+    constants: (MassModel, f64, f64),
+    on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
+) {
+    let pairs = contacts.iter().map(|contact| {
+        let (a, b) = (contact.a as usize, contact.b as usize);
+        let untouched = !touched[a] && !touched[b];
+        (touched[a], touched[b]) = (true, true);
+        (contact.a, contact.b, untouched.then_some(contact.geometry))
+    });
+    resolve_known_overlaps(pairs, circles, velocities, held, constants, on_exchange);
+}
+
+/// [`resolve_overlaps`] for pairs `(a, b, known)` that may come with their contact's geometry,
+/// `known`, when neither ball has moved since it was found.
+fn resolve_known_overlaps(
+    pairs: impl IntoIterator<Item = (u32, u32, Option<ContactGeometry>)>,
+    circles: &mut [Circle],
+    velocities: &mut [DVec2],
+    held: &mut [bool],
     (mass_model, restitution, rest_speed): (MassModel, f64, f64),
     mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
-    for (a, b) in pairs {
+    for (a, b, known) in pairs {
         let (ia, ib) = (a as usize, b as usize);
         if held[ia] && held[ib] {
             continue;
         }
         // Earlier pairs may have moved either ball: work from where they are now.
-        let Some(geometry) = circle_contact(circles[ia], circles[ib]) else {
+        let Some(geometry) = known.or_else(|| circle_contact(circles[ia], circles[ib])) else {
             continue;
         };
         let resting = (velocities[ia] - velocities[ib]).dot(geometry.normal) < rest_speed;
@@ -263,5 +300,54 @@ mod tests {
         assert_eq!(separation_shares(3.0, 1.0, 2.0), (1.0, 2.0));
         assert_eq!(separation_shares(-1.0, 1.0, 1.0), (0.0, 0.0));
         assert_eq!(separation_shares(1.0, 0.0, 0.0), (0.0, 0.0));
+    }
+
+    #[test]
+    fn contacts_taken_as_found_resolve_exactly_as_worked_out_again() {
+        use crate::sim::geometry::grid::UniformGrid;
+        use crate::sim::geometry::pairs::find_contacts;
+        use crate::sim::params::BroadPhase;
+        // A crowded jumble: most balls in several contacts, so many are moved before their turn.
+        let circles: Vec<Circle> = (0..600)
+            .map(|k| {
+                let (x, y) = ((k * 37 % 101) as f64 * 2.2, (k * 53 % 97) as f64 * 2.0);
+                Circle::new(DVec2::new(x, y), 2.0 + (k % 5) as f64 * 0.7)
+            })
+            .collect();
+        let velocities: Vec<DVec2> = (0..600)
+            .map(|k| DVec2::new((k % 13) as f64 - 6.0, (k % 7) as f64 - 3.0) * 40.0)
+            .collect();
+        let held: Vec<bool> = (0..600).map(|k| k % 11 == 0).collect();
+        let mut contacts = Vec::new();
+        find_contacts(
+            &circles,
+            BroadPhase::Grid,
+            &mut UniformGrid::default(),
+            &mut contacts,
+        );
+        assert!(contacts.len() > 500, "{} contacts", contacts.len());
+        let constants = (MassModel::Radius, 0.8, 5.0);
+        let run = |found: bool| {
+            let (mut c, mut v, mut h) = (circles.clone(), velocities.clone(), held.clone());
+            let mut exchanges = Vec::new();
+            let record = |a, b, geometry, exchange| exchanges.push((a, b, geometry, exchange));
+            if found {
+                let mut touched = vec![false; 600];
+                resolve_found_contacts(
+                    &contacts,
+                    &mut touched,
+                    &mut c,
+                    &mut v,
+                    &mut h,
+                    constants,
+                    record,
+                );
+            } else {
+                let pairs = contacts.iter().map(|contact| (contact.a, contact.b));
+                resolve_overlaps(pairs, &mut c, &mut v, &mut h, constants, record);
+            }
+            (c, v, h, format!("{exchanges:?}"))
+        };
+        assert_eq!(run(true), run(false));
     }
 }
