@@ -132,14 +132,9 @@ impl BallSnapshot {
     }
 
     /// Copies every ball into the snapshot, in query order, table by table and in pieces on
-    /// the compute pool for many balls.
-    pub fn fill(&mut self, balls: &SnapshotBalls) {
-        self.fill_then(balls, |_, _| ());
-    }
-
-    /// [`fill`](Self::fill), then `then(first, piece)` on each piece of balls just copied, while
-    /// it is in the cache (`first` is the index of its first ball); the results in the balls'
-    /// order.
+    /// the compute pool for many balls; then `then(first, piece)` on each piece of balls just
+    /// copied, while it is in the cache (`first` is the index of its first ball). Returns what
+    /// `then` gave, in the balls' order.
     pub fn fill_then<R: Send + 'static>(
         &mut self,
         balls: &SnapshotBalls,
