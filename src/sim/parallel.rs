@@ -21,6 +21,12 @@ pub fn piece_ranges(count: usize) -> impl Iterator<Item = Range<usize>> + Clone 
         .map(move |piece| piece * BALLS_PER_PIECE..((piece + 1) * BALLS_PER_PIECE).min(count))
 }
 
+/// `0..count` cut into `parts` consecutive ranges as near equal as can be (some empty when
+/// there are more parts than items): bands of rows or cells for the threads to share.
+pub fn split_evenly(count: usize, parts: usize) -> impl Iterator<Item = Range<usize>> + Clone {
+    (0..parts).map(move |part| count * part / parts..count * (part + 1) / parts)
+}
+
 /// The compute pool the parallel parts run on.
 pub fn compute_pool() -> &'static TaskPool {
     ComputeTaskPool::get_or_init(TaskPool::default)

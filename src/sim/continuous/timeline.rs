@@ -20,7 +20,7 @@ use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
 use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
 use crate::sim::geometry::pairs::find_contacts;
-use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_chosen};
+use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_all};
 use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 use crate::sim::params::BroadPhase;
 use crate::sim::report::{Hit, record_walls_met};
@@ -353,7 +353,7 @@ fn contain_at_the_end(
     on_hit: &mut impl FnMut(Hit),
 ) -> f64 {
     let arena = (spec.half, spec.restitution, spec.rest_speed);
-    let met = contain_chosen((circles, velocities), |_| true, |c, v| (c, v), arena);
+    let met = contain_all((circles, velocities), arena);
     let mut resting_impulse = 0.0;
     let recording = (spec.half, spec.restitution, spec.mass_model, spec.dt);
     record_walls_met(met, circles, recording, &mut resting_impulse, on_hit);

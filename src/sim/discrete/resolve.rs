@@ -8,8 +8,9 @@
 //! the balls in a contact in the arena again and writes every ball (the movement stage moved
 //! them in the snapshot) back to its components, both in pieces on the compute pool for many
 //! balls. Records each exchange and wall hit in the [`StepLog`]. The resting rule applies to
-//! pairs and walls alike (see [`resolve_overlaps`](crate::sim::geometry::impulse::resolve_overlaps)); pairs of resting balls are the resting
-//! stage's.
+//! pairs and walls alike (see
+//! [`resolve_overlaps`](crate::sim::geometry::impulse::resolve_overlaps)); pairs of resting
+//! balls are the resting stage's.
 
 use bevy::prelude::*;
 

@@ -6,7 +6,7 @@ use std::ops::Range;
 
 use super::circle::{Circle, ContactGeometry, circle_contact, circles_touch};
 use super::grid::{UniformGrid, for_each_pair};
-use crate::sim::parallel::{compute_pool, threads_at_work, worth_splitting};
+use crate::sim::parallel::{compute_pool, split_evenly, threads_at_work, worth_splitting};
 use crate::sim::params::BroadPhase;
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
@@ -84,8 +84,7 @@ pub fn search_in_bands<T: Send + 'static>(
         .map(|_| Vec::with_capacity(share + share / 8))
         .collect();
     compute_pool().scope(|scope| {
-        for (band, local) in bands.iter_mut().enumerate() {
-            let band_rows = rows * band / band_count..rows * (band + 1) / band_count;
+        for (band_rows, local) in split_evenly(rows, band_count).zip(&mut bands) {
             scope.spawn(async move { search(grid, band_rows, local) });
         }
     });

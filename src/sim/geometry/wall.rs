@@ -4,8 +4,8 @@
 //! The discrete mode contains every ball after moving it ([`contain_in_arena`]); the
 //! continuous mode finds each ball's exact moment at a wall ([`wall_time_of_impact`]) and
 //! bounces it there ([`bounce_off_wall`]), then contains at the end of the step against
-//! rounding; the aiming guide uses the same time of impact. Both contain many balls at once
-//! with [`contain_chosen`], in parallel for many balls.
+//! rounding; the aiming guide uses the same time of impact. Both contain many balls a piece at
+//! a time ([`contain_piece`]; [`contain_all`] runs the pieces in parallel for many balls).
 
 use bevy::math::DVec2;
 
@@ -133,15 +133,11 @@ pub fn contain_at_rest(
     }
 }
 
-/// [`contain_at_rest`] for each ball that `chosen(index)` picks, where `moved(center,
-/// velocity)` takes it first (the discrete mode's movement; for a ball already moved, the two
-/// as they are), with the arena's `(half, restitution, rest_speed)`. Updates `circles` and
-/// `velocities` in place, in pieces on the compute pool for many balls, and returns the balls
-/// that met a wall, in index order.
-pub fn contain_chosen(
+/// [`contain_at_rest`] for every ball, with the arena's `(half, restitution, rest_speed)`:
+/// `circles` and `velocities` updated in place, in pieces on the compute pool for many balls.
+/// Returns the balls that met a wall, in index order.
+pub fn contain_all(
     (circles, velocities): (&mut [Circle], &mut [DVec2]),
-    chosen: impl Fn(usize) -> bool + Sync,
-    moved: impl Fn(DVec2, DVec2) -> (DVec2, DVec2) + Sync,
     arena: (DVec2, f64, f64),
 ) -> Vec<(u32, Contained)> {
     let parallel = worth_splitting(circles.len());
@@ -149,12 +145,17 @@ pub fn contain_chosen(
         .chunks_mut(BALLS_PER_PIECE)
         .zip(velocities.chunks_mut(BALLS_PER_PIECE));
     let by_piece = in_pieces(pieces.enumerate(), parallel, |(piece, balls)| {
-        contain_piece(piece * BALLS_PER_PIECE, balls, &chosen, &moved, arena)
+        let (all, as_they_are) = (|_| true, |center, velocity| (center, velocity));
+        contain_piece(piece * BALLS_PER_PIECE, balls, &all, &as_they_are, arena)
     });
     by_piece.into_iter().flatten().collect()
 }
 
-/// [`contain_chosen`] on one piece of the balls, whose first has index `first`.
+/// [`contain_at_rest`] for each ball of a piece (whose first has index `first`) that
+/// `chosen(index)` picks, where `moved(center, velocity)` takes it first (the discrete mode's
+/// movement; for a ball already moved, the two as they are), with the arena's `(half,
+/// restitution, rest_speed)`. Updates `circles` and `velocities` in place and returns the
+/// balls that met a wall, in index order.
 pub fn contain_piece(
     first: usize,
     (circles, velocities): (&mut [Circle], &mut [DVec2]),

@@ -5,7 +5,7 @@
 
 use std::ops::Range;
 
-use crate::sim::parallel::{carve, in_pieces};
+use crate::sim::parallel::{carve, in_pieces, split_evenly};
 
 /// Marks a big ball, which has no cell.
 pub const NO_CELL: u32 = u32::MAX;
@@ -25,14 +25,13 @@ pub fn sort_into_cells(
     cell_start.resize(cell_count + 1, 0);
     sorted_index.resize(cell_of.len(), 0);
     let bands = bands.clamp(1, cell_count.max(1));
-    let band_cells = |band: usize| cell_count * band / bands..cell_count * (band + 1) / bands;
+    let band_cells = split_evenly(cell_count, bands);
     let parallel = bands > 1;
     // Each band counts its cells' balls: `cell_start` then holds each cell's end within the band.
     let totals = in_pieces(
-        (0..bands).map(band_cells).zip(carve(
-            &mut cell_start[..cell_count],
-            (0..bands).map(band_cells),
-        )),
+        band_cells
+            .clone()
+            .zip(carve(&mut cell_start[..cell_count], band_cells.clone())),
         parallel,
         |(cells, ends)| count_ends(cell_of, cells, ends),
     );
@@ -47,12 +46,9 @@ pub fn sort_into_cells(
         })
         .collect();
     // Then places them in reverse, counting each end down to its cell's start.
-    let bands_work = (0..bands)
-        .map(band_cells)
-        .zip(carve(
-            &mut cell_start[..cell_count],
-            (0..bands).map(band_cells),
-        ))
+    let bands_work = band_cells
+        .clone()
+        .zip(carve(&mut cell_start[..cell_count], band_cells))
         .zip(carve(sorted_index, band_slots.iter().cloned()))
         .zip(&band_slots);
     in_pieces(bands_work, parallel, |(((cells, ends), slots), range)| {

@@ -14,7 +14,7 @@ use super::counting::{NO_CELL, sort_into_cells};
 use super::rows::RowLists;
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
-    BALLS_PER_PIECE, carve, in_pieces, piece_ranges, threads_at_work, worth_splitting,
+    BALLS_PER_PIECE, carve, in_pieces, piece_ranges, split_evenly, threads_at_work, worth_splitting,
 };
 
 /// A ball whose radius is more than this many times the mean radius is big: see the header.
@@ -167,15 +167,12 @@ impl UniformGrid {
         let cell_count = self.cells.cell_count();
         let parallel = worth_splitting(order.len());
         let bands = if parallel { 4 * threads_at_work() } else { 1 };
-        let band_cells = |band: usize| cell_count * band / bands..cell_count * (band + 1) / bands;
+        let band_cells = split_evenly(cell_count, bands);
         let starts = &self.cell_start;
-        let band_slots = (0..bands).map(|band| {
-            let cells = band_cells(band);
-            starts[cells.start] as usize..starts[cells.end] as usize
-        });
-        let work = (0..bands)
-            .map(band_cells)
-            .zip(carve(&mut self.cell_of, band_slots));
+        let band_slots = band_cells
+            .clone()
+            .map(|cells| starts[cells.start] as usize..starts[cells.end] as usize);
+        let work = band_cells.zip(carve(&mut self.cell_of, band_slots));
         in_pieces(work, parallel, |(cells, slots)| {
             let first = starts[cells.start] as usize;
             for cell in cells {
