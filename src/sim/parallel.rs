@@ -38,10 +38,30 @@ pub fn threads_at_work() -> usize {
     compute_pool().thread_num() + 1
 }
 
-/// Whether a stage's work over `balls` balls runs in parallel: enough balls and more than one
-/// thread at work.
+/// Whether a stage's work over `balls` balls runs in parallel: enough balls, more than one
+/// thread at work, and not within [`one_thread_each`] work.
 pub fn worth_splitting(balls: usize) -> bool {
-    balls >= PARALLEL_MIN_BALLS && threads_at_work() > 1
+    balls >= PARALLEL_MIN_BALLS && threads_at_work() > 1 && !ONE_THREAD.get()
+}
+
+thread_local! {
+    /// Set while this thread runs work given one thread of its own.
+    static ONE_THREAD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// `work` done on each of `pieces` as [`in_pieces`] does, each piece on one thread: the work
+/// within a piece is not split again.
+pub fn one_thread_each<P: Send, R: Send + 'static>(
+    pieces: impl Iterator<Item = P>,
+    parallel: bool,
+    work: impl Fn(P) -> R + Sync,
+) -> Vec<R> {
+    in_pieces(pieces, parallel, |piece| {
+        let outer = ONE_THREAD.replace(true);
+        let result = work(piece);
+        ONE_THREAD.set(outer);
+        result
+    })
 }
 
 /// `work` done on each of `pieces`, on the compute pool if `parallel`, the results in the

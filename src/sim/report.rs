@@ -59,6 +59,15 @@ impl Hit {
         }
     }
 
+    /// The same hit with each ball's index `index` replaced by `renumber(index)`.
+    pub fn renumbered(mut self, renumber: impl Fn(u32) -> u32) -> Hit {
+        match &mut self {
+            Hit::Ball { a, b, .. } => (*a, *b) = (renumber(*a), renumber(*b)),
+            Hit::Wall { ball, .. } => *ball = renumber(*ball),
+        }
+        self
+    }
+
     /// The wall hits of a containment of ball `ball` (of `mass`) at `time` into the step, in
     /// the arena `[-half, half]`; a resting stop is not a hit (see
     /// [`Contained::resting_impulse`]).
@@ -135,6 +144,19 @@ pub struct StepLog {
 }
 
 impl StepLog {
+    /// Whether this step keeps its ball hits and contact points, rather than only counting
+    /// them.
+    pub fn keeps_ball_hits(&self) -> bool {
+        !self.hits.drop_ball_hits
+    }
+
+    /// Counts `count` ball hits, and their contact points, that this step drops.
+    pub fn count_dropped_ball_hits(&mut self, count: u64) {
+        debug_assert!(self.hits.drop_ball_hits || count == 0);
+        self.contact_count += count;
+        self.hits.ball_hits_not_kept += count;
+    }
+
     /// Counts a contact point, and keeps it if this step's [`HitReports`] asks for them.
     pub fn note_contact(&mut self, contact: ContactPoint) {
         self.contact_count += 1;

@@ -36,6 +36,11 @@ pub fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2)
 /// `other` values from here up name a wall, below it a ball.
 const WALL_BASE: u32 = u32::MAX - 3;
 
+/// The code by which an impact names `wall` in the place of a ball.
+pub fn wall_code(wall: Wall) -> u32 {
+    WALL_BASE + wall as u32
+}
+
 /// A predicted impact: ball `a` with ball `other` or with a wall. The timeline knows its balls
 /// by slot (their place in the grid's cell order); `indices` holds the same balls' indices in
 /// the step's input, by which impacts at the same time are ordered, as they were before the
@@ -80,7 +85,7 @@ impl Party {
 impl Impact {
     /// Ball `ball` reaching `wall` at `time`.
     pub fn with_wall(time: f64, ball: Party, wall: Wall) -> Self {
-        let other = WALL_BASE + wall as u32;
+        let other = wall_code(wall);
         Self {
             time,
             a: ball.slot as u32,

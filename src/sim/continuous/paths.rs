@@ -54,6 +54,16 @@ impl Paths {
         self.far.clear();
     }
 
+    /// How far, along either axis, any path so far reaches from its ball's cell.
+    pub fn reach(&self) -> f64 {
+        self.reach
+    }
+
+    /// Whether some path is kept apart (a big ball's or a far-reaching one).
+    pub fn keeps_some_apart(&self) -> bool {
+        !self.far.is_empty()
+    }
+
     /// Ball `slot`, which now has `hits` hits, takes a new path that sweeps `swept`.
     pub fn redirect(&mut self, grid: &mut UniformGrid, slot: u32, hits: u32, swept: Circle) {
         let slot_index = slot as usize;

@@ -5,6 +5,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use super::bands::Bands;
 use super::impact::Prediction;
 use super::paths::Paths;
 use super::queue::ImpactQueue;
@@ -153,9 +154,27 @@ pub struct Timeline {
     pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.
     pub(super) fallback: Vec<IndexedContact>,
+    /// The step in bands, for many balls ([`Bands`]), and whether this step is taken so.
+    pub bands: Bands,
+    pub(super) banded: bool,
     /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
     pub cut_short: bool,
     /// The walls' impulse on balls that stopped against them by the resting rule in the last
     /// run, mass x pixels per second: pressure, not hits.
     pub resting_wall_impulse: f64,
+}
+
+impl Timeline {
+    /// Whether the grid keeps no ball apart as big.
+    pub(super) fn has_no_big_ball(&self) -> bool {
+        self.grid.small_count() == self.grid.len()
+    }
+
+    /// How far apart, along either axis, two balls whose paths could meet in the last run
+    /// started, at most. Each path lies within [`Paths::reach`] of its ball's cell, which
+    /// holds the centre of the ball's first path, itself within that reach of its start; two
+    /// paths meet only if their balls' cells lie within twice the reach of each other.
+    pub(super) fn reach_bound(&self) -> f64 {
+        2.0 * self.grid.cell_size() + 4.0 * self.paths.reach()
+    }
 }

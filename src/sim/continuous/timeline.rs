@@ -40,22 +40,50 @@ impl Timeline {
         spec: StepSpec,
         mut on_hit: impl FnMut(Hit),
     ) {
+        self.run_impacts(circles, velocities, (held, stopped), spec, &mut on_hit);
+        if self.cut_short {
+            self.resolve_what_was_cut_short(circles, velocities, held, spec, &mut on_hit);
+        }
+        self.push_apart_overlaps(circles, held, spec);
+        self.resting_wall_impulse += contain_at_the_end(circles, velocities, spec, &mut on_hit);
+    }
+
+    /// The impacts in time order, then every ball to the end of the step: [`run`](Self::run)
+    /// but the fallback for balls cut short, the overlaps and the walls at the end.
+    pub(super) fn run_impacts(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        (held, stopped): (&mut [bool], &mut [bool]),
+        spec: StepSpec,
+        on_hit: &mut impl FnMut(Hit),
+    ) {
         self.start();
         while let Some(impact) = self.queue.pop() {
             if !self.is_current(&impact) {
                 continue;
             }
             match impact.wall() {
-                Some(wall) => self.bounce_off(impact, wall, spec, &mut on_hit),
-                None => self.collide(impact, spec, &mut on_hit),
+                Some(wall) => self.bounce_off(impact, wall, spec, on_hit),
+                None => self.collide(impact, spec, on_hit),
             }
         }
         self.move_to_the_end(circles, velocities, (held, stopped), spec);
-        if self.cut_short {
-            self.resolve_what_was_cut_short(circles, velocities, held, spec, &mut on_hit);
-        }
-        self.push_apart_overlaps(circles, held, spec);
-        self.resting_wall_impulse += contain_at_the_end(circles, velocities, spec, &mut on_hit);
+    }
+
+    /// The end of a step whose impacts ran in bands ([`Bands`](super::bands::Bands)), where
+    /// nothing overlapped at the start and no ball was cut short: the walls, as
+    /// [`run`](Self::run) ends.
+    pub(super) fn finish_after_bands(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        spec: StepSpec,
+        mut on_hit: impl FnMut(Hit),
+    ) {
+        self.overlapping.clear();
+        self.cut_short = false;
+        self.resting_wall_impulse = contain_at_the_end(circles, velocities, spec, &mut on_hit);
     }
 
     /// Every ball at the start of the step (placed by [`predict`](Self::predict)), no hits

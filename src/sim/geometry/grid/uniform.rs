@@ -219,6 +219,11 @@ impl UniformGrid {
         self.small_reach
     }
 
+    /// The side of a cell, pixels.
+    pub fn cell_size(&self) -> f64 {
+        self.cells.cell_size()
+    }
+
     /// Number of balls sorted in.
     pub fn len(&self) -> usize {
         self.sorted_index.len()

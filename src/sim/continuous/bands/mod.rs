@@ -1,0 +1,533 @@
+//! Stages 2 and 3, continuous, for many balls: the timeline in horizontal bands of the arena,
+//! at once on the compute pool, with exactly the single timeline's result.
+//!
+//! An impact involves only balls whose paths meet, and within a step a path reaches only so
+//! far from its ball's start, so far-apart parts of the arena have independent timelines.
+//! 1. [`Bands::predict`] cuts the arena into bands of about as many balls each. Each band
+//!    takes the balls starting in it (its own) and those within a halo `HALO_DIAMETERS`
+//!    largest diameters wide on each side, and predicts their impacts as the single
+//!    timeline does (`Timeline::predict`, on the band's balls alone).
+//! 2. [`Bands::run`] runs each band's impacts in time order. The halo's outer balls miss
+//!    their neighbours beyond it, so their histories may be wrong; a wrong history can reach
+//!    the band's own balls only through the halo balls within `Δ` of the band, where `Δ`
+//!    bounds how far apart two balls that may meet start (from each band's cells and how far
+//!    its paths reached, `reach_bound`). So those balls' ends of step are compared, bit for
+//!    bit, with what their own band made of them.
+//! 3. If every comparison holds, every ball takes its own band's end of step, and the hits
+//!    are reported in the order the single timeline takes them (by time, then balls).
+//!    Otherwise — or if a band's step was cut short, began with overlaps or kept paths apart,
+//!    or the resting rule is on — the caller runs the step as one timeline.
+//!
+//! The result is the single timeline's whether the bands hold or not, so it never depends on
+//! how many bands (or threads) there are (tested).
+
+use bevy::math::DVec2;
+
+mod layout;
+
+use layout::Survey;
+
+use super::impact::wall_code;
+use super::state::{StepSpec, Timeline};
+use crate::sim::geometry::Circle;
+use crate::sim::parallel::{
+    BALLS_PER_PIECE, PARALLEL_MIN_BALLS, in_pieces, one_thread_each, piece_ranges, threads_at_work,
+    worth_splitting,
+};
+use crate::sim::report::Hit;
+
+/// Below this many balls the step is one timeline: the other stages split their work from
+/// here on too.
+const MIN_BALLS: usize = PARALLEL_MIN_BALLS;
+
+/// Above this many balls the step is one timeline: each band's buffers are its own, and at a
+/// million balls the bands' together passed the memory target (524 against 369 MB).
+const MAX_BALLS: usize = 400_000;
+
+/// The halo on each side of a band, in largest diameters.
+const HALO_DIAMETERS: f64 = 10.0;
+
+/// The bands of the current step, kept between steps to reuse their buffers.
+#[derive(Debug, Default)]
+pub struct Bands {
+    bands: Vec<Band>,
+    /// Pixels.
+    halo: f64,
+    /// Steps whose impacts the bands took, and steps run again as one timeline because the
+    /// bands did not hold.
+    pub steps_in_bands: u64,
+    pub steps_run_again: u64,
+}
+
+/// One band: its own balls start at `low <= y < high`.
+#[derive(Debug, Default)]
+struct Band {
+    low: f64,
+    high: f64,
+    timeline: Timeline,
+    /// Its balls (own and halo) by their index in the step's input, in increasing order, so
+    /// ties between impacts fall as they do in the single timeline.
+    balls: Vec<u32>,
+    own: Vec<bool>,
+    own_count: usize,
+    circles: Vec<Circle>,
+    velocities: Vec<DVec2>,
+    held: Vec<bool>,
+    stopped: Vec<bool>,
+    /// Its own balls' hits, by input index.
+    hits: Vec<Hit>,
+    /// Its own balls' ball hits, when only counted.
+    ball_hits_counted: u64,
+}
+
+impl Timeline {
+    /// Stage 2 for a step: in bands for many balls and more than one thread, else as one
+    /// timeline ([`predict`](Self::predict)).
+    pub fn predict_step(
+        &mut self,
+        circles: &[Circle],
+        velocities: &[DVec2],
+        held: &[bool],
+        spec: StepSpec,
+    ) {
+        let count = Bands::count_for(circles.len());
+        self.predict_in_bands((count, HALO_DIAMETERS), circles, velocities, held, spec);
+    }
+
+    /// [`predict_step`](Self::predict_step) in `count` bands with halos `halo_diameters`
+    /// largest diameters wide (one timeline if `count` is 1, or if they cannot be used).
+    fn predict_in_bands(
+        &mut self,
+        (count, halo_diameters): (usize, f64),
+        circles: &[Circle],
+        velocities: &[DVec2],
+        held: &[bool],
+        spec: StepSpec,
+    ) {
+        let bands = &mut self.bands;
+        self.banded =
+            count > 1 && bands.predict((count, halo_diameters), circles, velocities, held, spec);
+        if !self.banded {
+            self.predict(circles, velocities, held, spec);
+        }
+    }
+
+    /// Stage 3 for a step predicted by [`predict_step`](Self::predict_step): what
+    /// [`run`](Self::run) does, in the bands if they were used and hold, else as one timeline
+    /// (predicted again if need be). Hands every hit to `on_hit` in the order handled, but,
+    /// unless `keep_ball_hits`, only counts the ball hits of a step taken in bands: returns
+    /// how many it only counted.
+    pub fn run_step(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        (held, stopped): (&mut [bool], &mut [bool]),
+        spec: StepSpec,
+        keep_ball_hits: bool,
+        mut on_hit: impl FnMut(Hit),
+    ) -> u64 {
+        if self.banded {
+            let balls = (&mut *held, &mut *stopped);
+            let bands = &mut self.bands;
+            if let Some(counted) = bands.run(
+                circles,
+                velocities,
+                balls,
+                spec,
+                keep_ball_hits,
+                &mut on_hit,
+            ) {
+                self.finish_after_bands(circles, velocities, spec, on_hit);
+                return counted;
+            }
+            // The bands did not hold: the step as one timeline.
+            self.predict(circles, velocities, held, spec);
+        }
+        self.run(circles, velocities, (held, stopped), spec, on_hit);
+        0
+    }
+}
+
+impl Bands {
+    /// How many bands a step of `balls` balls takes: one for each thread at work, or 1 (the
+    /// single timeline) for few balls, very many, or one thread.
+    fn count_for(balls: usize) -> usize {
+        if (MIN_BALLS..=MAX_BALLS).contains(&balls) {
+            threads_at_work()
+        } else {
+            1
+        }
+    }
+
+    /// Stage 2 in `count` bands with halos `halo_diameters` largest diameters wide: each
+    /// band's balls gathered and their impacts predicted. Returns false if the step cannot be
+    /// taken in bands.
+    fn predict(
+        &mut self,
+        (count, halo_diameters): (usize, f64),
+        circles: &[Circle],
+        velocities: &[DVec2],
+        held: &[bool],
+        spec: StepSpec,
+    ) -> bool {
+        if spec.rest_speed != 0.0 || count < 2 {
+            return false; // the resting rule sums the walls' stops in the order handled
+        }
+        let survey = Survey::of(circles, spec.half.y);
+        if survey.may_have_big_balls() {
+            return false;
+        }
+        self.halo = halo_diameters * 2.0 * survey.largest;
+        let Some(edges) = survey.edges(count, spec.half.y, self.halo) else {
+            return false;
+        };
+        self.bands.resize_with(count, Band::default);
+        for (band, pair) in self.bands.iter_mut().zip(edges.windows(2)) {
+            (band.low, band.high) = (pair[0], pair[1]);
+        }
+        let halo = self.halo;
+        let parallel = threads_at_work() > 1;
+        one_thread_each(self.bands.iter_mut(), parallel, |band| {
+            band.gather(circles, velocities, held, halo);
+            band.timeline
+                .predict(&band.circles, &band.velocities, &band.held, spec);
+        });
+        let own: usize = self.bands.iter().map(|band| band.own_count).sum();
+        // Every ball in some band (none lost to a NaN), no big ball in any.
+        own == circles.len()
+            && self
+                .bands
+                .iter()
+                .all(|band| band.timeline.has_no_big_ball())
+    }
+
+    /// Stage 3 in the bands [`predict`](Self::predict) made: each band's impacts, then, if
+    /// the bands hold, every ball's end of the timeline written to the arrays (as
+    /// `Timeline::run_impacts` writes it) and the hits handed to `on_hit` in the single
+    /// timeline's order — every ball hit if `keep_ball_hits`, else only the wall hits. Returns
+    /// the ball hits only counted, or `None`, having changed nothing, if the bands do not
+    /// hold.
+    fn run(
+        &mut self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        (held, stopped): (&mut [bool], &mut [bool]),
+        spec: StepSpec,
+        keep_ball_hits: bool,
+        mut on_hit: impl FnMut(Hit),
+    ) -> Option<u64> {
+        let parallel = threads_at_work() > 1;
+        one_thread_each(self.bands.iter_mut(), parallel, |band| {
+            band.run(spec, keep_ball_hits);
+        });
+        if !self.hold(circles) {
+            self.steps_run_again += 1;
+            return None;
+        }
+        self.steps_in_bands += 1;
+        self.write_own_ends(circles, velocities, (held, stopped));
+        let mut hits = Vec::new();
+        let mut counted = 0;
+        for band in &mut self.bands {
+            hits.append(&mut band.hits);
+            counted += band.ball_hits_counted;
+        }
+        hits.sort_unstable_by(|a, b| {
+            let (time_a, key_a) = order_of(a);
+            let (time_b, key_b) = order_of(b);
+            time_a.total_cmp(&time_b).then(key_a.cmp(&key_b))
+        });
+        hits.into_iter().for_each(&mut on_hit);
+        Some(counted)
+    }
+
+    /// Every ball's end of step, from its own band, in pieces of the arrays on the compute
+    /// pool for many balls (each band's balls are in index order, so each piece reads a run
+    /// of each band's).
+    fn write_own_ends(
+        &self,
+        circles: &mut [Circle],
+        velocities: &mut [DVec2],
+        (held, stopped): (&mut [bool], &mut [bool]),
+    ) {
+        let count = circles.len();
+        let pieces = circles
+            .chunks_mut(BALLS_PER_PIECE)
+            .zip(velocities.chunks_mut(BALLS_PER_PIECE))
+            .zip(held.chunks_mut(BALLS_PER_PIECE))
+            .zip(stopped.chunks_mut(BALLS_PER_PIECE))
+            .zip(piece_ranges(count));
+        in_pieces(
+            pieces,
+            worth_splitting(count),
+            |((((circles, velocities), held), stopped), range)| {
+                for band in &self.bands {
+                    let first = band
+                        .balls
+                        .partition_point(|&index| (index as usize) < range.start);
+                    let last = band
+                        .balls
+                        .partition_point(|&index| (index as usize) < range.end);
+                    for local in first..last {
+                        if band.own[local] {
+                            let at = band.balls[local] as usize - range.start;
+                            circles[at].center = band.circles[local].center;
+                            velocities[at] = band.velocities[local];
+                            held[at] = band.held[local];
+                            stopped[at] = band.stopped[local];
+                        }
+                    }
+                }
+            },
+        );
+    }
+
+    /// Whether every band's result for its own balls is the single timeline's (see the
+    /// header).
+    fn hold(&self, circles: &[Circle]) -> bool {
+        let plain = self.bands.iter().all(|band| {
+            let timeline = &band.timeline;
+            !timeline.cut_short
+                && timeline.overlapping.is_empty()
+                && !timeline.paths.keeps_some_apart()
+        });
+        let reach = self.bands.iter().map(|band| band.timeline.reach_bound());
+        let reach = reach.fold(0.0, f64::max);
+        plain
+            && reach <= self.halo
+            && self.bands.windows(2).all(|pair| {
+                let near =
+                    |index: u32| (circles[index as usize].center.y - pair[0].high).abs() <= reach;
+                alike_where(&pair[0], &pair[1], near)
+            })
+    }
+}
+
+impl Band {
+    /// Its balls, own and halo, from the step's arrays.
+    fn gather(&mut self, circles: &[Circle], velocities: &[DVec2], held: &[bool], halo: f64) {
+        let (low, high) = (self.low, self.high);
+        self.balls.clear();
+        self.own.clear();
+        self.own_count = 0;
+        for (index, circle) in circles.iter().enumerate() {
+            let y = circle.center.y;
+            if y >= low - halo && y < high + halo {
+                let own = y >= low && y < high;
+                self.balls.push(index as u32);
+                self.own.push(own);
+                self.own_count += usize::from(own);
+            }
+        }
+        let balls = &self.balls;
+        self.circles.clear();
+        self.circles
+            .extend(balls.iter().map(|&index| circles[index as usize]));
+        self.velocities.clear();
+        self.velocities
+            .extend(balls.iter().map(|&index| velocities[index as usize]));
+        self.held.clear();
+        self.held
+            .extend(balls.iter().map(|&index| held[index as usize]));
+    }
+
+    /// Its impacts, each of its own balls' hits kept (ball hits only counted unless
+    /// `keep_ball_hits`).
+    fn run(&mut self, spec: StepSpec, keep_ball_hits: bool) {
+        self.stopped.clear();
+        self.stopped.resize(self.balls.len(), false);
+        self.hits.clear();
+        self.ball_hits_counted = 0;
+        let (balls, own) = (&self.balls, &self.own);
+        let (hits, counted) = (&mut self.hits, &mut self.ball_hits_counted);
+        let mut record = |hit: Hit| {
+            let (first, is_ball_hit) = match hit {
+                Hit::Ball { a, .. } => (a, true),
+                Hit::Wall { ball, .. } => (ball, false),
+            };
+            if !own[first as usize] {
+                return; // the band that owns it records it
+            }
+            if is_ball_hit && !keep_ball_hits {
+                *counted += 1;
+            } else {
+                hits.push(hit.renumbered(|local| balls[local as usize]));
+            }
+        };
+        let arrays = (&mut self.held[..], &mut self.stopped[..]);
+        self.timeline.run_impacts(
+            &mut self.circles,
+            &mut self.velocities,
+            arrays,
+            spec,
+            &mut record,
+        );
+    }
+}
+
+/// Whether `below` and `above` ended the step alike, to the bit, for every ball of both
+/// whose index is `near`.
+fn alike_where(below: &Band, above: &Band, near: impl Fn(u32) -> bool) -> bool {
+    let (mut i, mut j) = (0, 0);
+    while i < below.balls.len() && j < above.balls.len() {
+        let (index_below, index_above) = (below.balls[i], above.balls[j]);
+        if index_below < index_above {
+            i += 1;
+        } else if index_above < index_below {
+            j += 1;
+        } else {
+            if near(index_below) && !same_end(below, i, above, j) {
+                return false;
+            }
+            i += 1;
+            j += 1;
+        }
+    }
+    true
+}
+
+/// Whether ball `i` of `one` and ball `j` of `other` ended the step alike, to the bit.
+fn same_end(one: &Band, i: usize, other: &Band, j: usize) -> bool {
+    let bits = |v: DVec2| (v.x.to_bits(), v.y.to_bits());
+    bits(one.circles[i].center) == bits(other.circles[j].center)
+        && bits(one.velocities[i]) == bits(other.velocities[j])
+        && one.held[i] == other.held[j]
+        && one.stopped[i] == other.stopped[j]
+}
+
+/// A hit's place in the single timeline's order: its time, then its balls' indices (a
+/// wall's code for a wall), as [`Impact`](super::impact::Impact)s are ordered.
+fn order_of(hit: &Hit) -> (f64, (u32, u32)) {
+    match *hit {
+        Hit::Ball { a, b, time, .. } => (time, (a, b)),
+        Hit::Wall {
+            ball, wall, time, ..
+        } => (time, (ball, wall_code(wall))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::sim::params::MassModel;
+
+    /// `count` balls of radius 5–15 px, about 30% of a square arena, stored row by row as a
+    /// scene spawns them, at up to 500 px/s: the standard gas.
+    fn gas(count: usize) -> (Vec<Circle>, Vec<DVec2>, StepSpec) {
+        let side = (count as f64 * std::f64::consts::PI * 108.3 / 0.3).sqrt();
+        let columns = (count as f64).sqrt().ceil() as usize;
+        let pitch = side / columns as f64;
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let circles = (0..count)
+            .map(|k| {
+                let cell = DVec2::new((k % columns) as f64, (k / columns) as f64);
+                let jitter = DVec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                let center = (cell + DVec2::splat(0.5)) * pitch - DVec2::splat(side / 2.0) + jitter;
+                Circle::new(center, rng.random_range(5.0..15.0))
+            })
+            .collect();
+        let velocities = (0..count)
+            .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..500.0))
+            .collect();
+        let spec = StepSpec {
+            dt: 1.0 / 60.0,
+            half: DVec2::splat(side / 2.0),
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+            gravity: DVec2::ZERO,
+            rest_speed: 0.0,
+        };
+        (circles, velocities, spec)
+    }
+
+    /// Eight steps of `count` balls in `bands` (count, halo in largest diameters): the balls
+    /// at the end, the hits kept, the ball hits only counted (if not `keep_ball_hits`), and
+    /// the steps the bands took and ran again.
+    fn steps(bands: (usize, f64), keep_ball_hits: bool) -> (String, Vec<String>, u64, (u64, u64)) {
+        let (mut circles, mut velocities, spec) = gas(6_000);
+        let (mut held, mut stopped) = (vec![false; 6_000], vec![false; 6_000]);
+        let mut timeline = Timeline::default();
+        let (mut hits, mut counted) = (Vec::new(), 0);
+        for _ in 0..8 {
+            timeline.predict_in_bands(bands, &circles, &velocities, &held, spec);
+            let flags = (&mut held[..], &mut stopped[..]);
+            let record = |hit: Hit| hits.push(format!("{hit:?}"));
+            counted += timeline.run_step(
+                &mut circles,
+                &mut velocities,
+                flags,
+                spec,
+                keep_ball_hits,
+                record,
+            );
+        }
+        let state = format!("{circles:?} {velocities:?} {held:?} {stopped:?}");
+        let taken = (
+            timeline.bands.steps_in_bands,
+            timeline.bands.steps_run_again,
+        );
+        (state, hits, counted, taken)
+    }
+
+    #[test]
+    fn two_bands_are_alike_only_if_every_ball_near_their_edge_ended_alike_to_the_bit() {
+        let band = |balls: Vec<u32>, x: &[f64], vx: &[f64]| Band {
+            balls,
+            circles: x
+                .iter()
+                .map(|&x| Circle::new(DVec2::new(x, 0.0), 1.0))
+                .collect(),
+            velocities: vx.iter().map(|&vx| DVec2::new(vx, 0.0)).collect(),
+            held: vec![false; x.len()],
+            stopped: vec![false; x.len()],
+            ..Band::default()
+        };
+        // Balls 2 and 4 are in both; 4 ended elsewhere, 2 with -0 for 0 px/s.
+        let below = band(
+            vec![1, 2, 4, 7],
+            &[1.0, 2.0, 4.0, 7.0],
+            &[0.0, 0.0, 1.0, 0.0],
+        );
+        let above = band(
+            vec![2, 3, 4, 9],
+            &[2.0, 3.0, 4.5, 9.0],
+            &[-0.0, 0.0, 1.0, 0.0],
+        );
+        assert!(alike_where(&below, &above, |index| index == 3 || index == 7));
+        assert!(!alike_where(&below, &above, |index| index == 4));
+        assert!(!alike_where(&below, &above, |index| index == 2));
+        let mut same_ends = band(vec![2, 4], &[2.0, 4.0], &[0.0, 1.0]);
+        assert!(alike_where(&below, &same_ends, |_| true));
+        same_ends.stopped[1] = true;
+        assert!(!alike_where(&below, &same_ends, |_| true));
+    }
+
+    #[test]
+    fn bands_give_the_single_timeline_s_steps_to_the_bit_whether_they_hold_or_not() {
+        let (state, hits, counted, taken) = steps((1, HALO_DIAMETERS), true);
+        assert_eq!((counted, taken), (0, (0, 0)));
+        let ball_hits = hits.iter().filter(|hit| hit.starts_with("Ball")).count();
+        assert!(ball_hits > 5_000, "{ball_hits} ball hits");
+        // Three bands with the step's halos hold every step.
+        let held = steps((3, HALO_DIAMETERS), true);
+        assert!(held.0 == state, "the balls differ");
+        assert!(held.1 == hits, "the hits differ");
+        assert_eq!((held.2, held.3), (0, (8, 0)));
+        // Halos too narrow to hold: every step is run again as one timeline.
+        let narrow = steps((3, 1.5), true);
+        assert!(narrow.0 == state && narrow.1 == hits);
+        assert_eq!(narrow.3, (0, 8));
+        // Ball hits only counted: as many, and the wall hits alone, in order.
+        let counting = steps((3, HALO_DIAMETERS), false);
+        let wall_hits: Vec<String> = hits
+            .iter()
+            .filter(|hit| hit.starts_with("Wall"))
+            .cloned()
+            .collect();
+        assert!(counting.0 == state);
+        assert_eq!((counting.1, counting.2 as usize), (wall_hits, ball_hits));
+    }
+}
