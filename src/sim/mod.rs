@@ -164,6 +164,7 @@ fn add_resources_and_messages(app: &mut App) {
         .init_resource::<discrete::detect::Contacts>()
         .init_resource::<discrete::detect::DetectionGrid>()
         .init_resource::<continuous::Timeline>()
+        .init_resource::<continuous::Bands>()
         .init_resource::<resting::RestingState>()
         .init_resource::<SpawnSettings>()
         .init_resource::<BallCountOutcome>()

@@ -57,11 +57,25 @@ pub fn one_thread_each<P: Send, R: Send + 'static>(
     work: impl Fn(P) -> R + Sync,
 ) -> Vec<R> {
     in_pieces(pieces, parallel, |piece| {
-        let outer = ONE_THREAD.replace(true);
-        let result = work(piece);
-        ONE_THREAD.set(outer);
-        result
+        let _one_thread = OneThread::claim();
+        work(piece)
     })
+}
+
+/// While alive, this thread's work is not split ([`worth_splitting`] is false); it restores
+/// what was before when dropped, even by a panic.
+struct OneThread(bool);
+
+impl OneThread {
+    fn claim() -> Self {
+        Self(ONE_THREAD.replace(true))
+    }
+}
+
+impl Drop for OneThread {
+    fn drop(&mut self) {
+        ONE_THREAD.set(self.0);
+    }
 }
 
 /// `work` done on each of `pieces`, on the compute pool if `parallel`, the results in the

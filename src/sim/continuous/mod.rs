@@ -20,7 +20,8 @@
 //! what its edge balls did matches what the band beside made of them, so the result is the
 //! single timeline's to the bit, or the step is run again as one.
 //!
-//! [`state`] holds the [`Timeline`] resource both halves work on.
+//! [`state`] holds the [`Timeline`] resource both halves work on; the [`Bands`] resource
+//! holds the bands' own timelines.
 //!
 //! The [`Timeline`] works on plain arrays, so it is tested without an app.
 
@@ -38,6 +39,7 @@ use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back};
 use crate::sim::clock::SimClock;
 use crate::sim::params::SimParams;
 use crate::sim::report::{ContactPoint, Hit, StepLog};
+pub use bands::Bands;
 pub use state::{MAX_HITS_PER_BALL, StepSpec, Timeline};
 
 /// Stage 2: every impact of the coming step that the balls' paths lead to.
@@ -46,12 +48,14 @@ pub fn predict_impacts(
     params: Res<SimParams>,
     snapshot: Res<BallSnapshot>,
     mut timeline: ResMut<Timeline>,
+    mut bands: ResMut<Bands>,
 ) {
     if snapshot.all_held() {
         return; // nothing flies: `run_timeline` has nothing to do either
     }
     let spec = StepSpec::new(&params, clock.dt);
-    timeline.predict_step(
+    bands.predict_step(
+        &mut timeline,
         &snapshot.circles,
         &snapshot.velocities,
         &snapshot.held,
@@ -64,6 +68,7 @@ pub fn run_timeline(
     clock: Res<SimClock>,
     params: Res<SimParams>,
     mut timeline: ResMut<Timeline>,
+    mut bands: ResMut<Bands>,
     mut snapshot: ResMut<BallSnapshot>,
     mut balls: WrittenBalls,
     mut log: ResMut<StepLog>,
@@ -81,8 +86,12 @@ pub fn run_timeline(
     } = &mut *snapshot;
     let log = &mut *log;
     let keep_ball_hits = log.keeps_ball_hits();
-    let flags = (&mut **held, &mut **stopped);
-    let counted = timeline.run_step(circles, velocities, flags, spec, keep_ball_hits, |hit| {
+    let (arrays, flags) = (
+        (&mut **circles, &mut **velocities),
+        (&mut **held, &mut **stopped),
+    );
+    let timeline = &mut *timeline;
+    let counted = bands.run_step(timeline, arrays, flags, spec, keep_ball_hits, |hit| {
         if let Hit::Ball { point, normal, .. } = hit {
             log.note_contact(ContactPoint { point, normal });
         }

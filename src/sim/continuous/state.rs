@@ -5,7 +5,6 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::bands::Bands;
 use super::impact::Prediction;
 use super::paths::Paths;
 use super::queue::ImpactQueue;
@@ -154,9 +153,9 @@ pub struct Timeline {
     pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.
     pub(super) fallback: Vec<IndexedContact>,
-    /// The step in bands, for many balls ([`Bands`]), and whether this step is taken so.
-    pub bands: Bands,
-    pub(super) banded: bool,
+    /// Whether the last run handled some impact after one that comes later in the impacts'
+    /// order (see `Impact`'s `Ord`): then its hits are not in that order.
+    pub(super) out_of_order: bool,
     /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
     pub cut_short: bool,
     /// The walls' impulse on balls that stopped against them by the resting rule in the last
@@ -171,10 +170,21 @@ impl Timeline {
     }
 
     /// How far apart, along either axis, two balls whose paths could meet in the last run
-    /// started, at most. Each path lies within [`Paths::reach`] of its ball's cell, which
-    /// holds the centre of the ball's first path, itself within that reach of its start; two
-    /// paths meet only if their balls' cells lie within twice the reach of each other.
-    pub(super) fn reach_bound(&self) -> f64 {
-        2.0 * self.grid.cell_size() + 4.0 * self.paths.reach()
+    /// started, at most; `None` if the grid's cells do not hold their balls. Each path lies
+    /// within [`Paths::reach`] of its ball's cell, which holds the centre of the ball's first
+    /// path, itself within that reach of its start; two paths meet only if their balls' cells
+    /// lie within twice the reach of each other.
+    pub(super) fn reach_bound(&self) -> Option<f64> {
+        let bound = 2.0 * self.grid.cell_size() + 4.0 * self.paths.reach();
+        self.grid.cells_hold_their_balls().then_some(bound)
+    }
+
+    /// Each ball's hits in the last run, by its index in the run's arrays, into `hits`.
+    pub(super) fn hits_by_index(&self, hits: &mut Vec<u32>) {
+        hits.clear();
+        hits.resize(self.order.len(), 0);
+        for (mover, &index) in self.movers.iter().zip(&self.order) {
+            hits[index as usize] = mover.hits;
+        }
     }
 }

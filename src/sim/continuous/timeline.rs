@@ -59,10 +59,15 @@ impl Timeline {
         on_hit: &mut impl FnMut(Hit),
     ) {
         self.start();
+        let mut last = None;
         while let Some(impact) = self.queue.pop() {
             if !self.is_current(&impact) {
                 continue;
             }
+            // An impact predicted for the very moment of the one that redirected its ball can
+            // come before that one in the impacts' order.
+            self.out_of_order |= last.is_some_and(|last| impact < last);
+            last = Some(impact);
             match impact.wall() {
                 Some(wall) => self.bounce_off(impact, wall, spec, on_hit),
                 None => self.collide(impact, spec, on_hit),
@@ -71,9 +76,9 @@ impl Timeline {
         self.move_to_the_end(circles, velocities, (held, stopped), spec);
     }
 
-    /// The end of a step whose impacts ran in bands ([`Bands`](super::bands::Bands)), where
-    /// nothing overlapped at the start and no ball was cut short: the walls, as
-    /// [`run`](Self::run) ends.
+    /// The end of a step whose impacts ran in bands that held ([`Bands`](super::bands::Bands)):
+    /// no band's balls overlapped at the start or were cut short, so only the walls are left,
+    /// as [`run`](Self::run) ends.
     pub(super) fn finish_after_bands(
         &mut self,
         circles: &mut [Circle],
@@ -106,6 +111,7 @@ impl Timeline {
             }
         }
         self.cut_short = false;
+        self.out_of_order = false;
         self.resting_wall_impulse = 0.0;
     }
 

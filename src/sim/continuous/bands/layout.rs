@@ -62,6 +62,9 @@ impl Survey {
     /// The edges of `count` bands of about as many balls each over the arena's height, the
     /// outer ones open (`-inf`, `+inf`); `None` if some band would be no taller than `halo`.
     pub fn edges(&self, count: usize, half_height: f64, halo: f64) -> Option<Vec<f64>> {
+        if count < 2 {
+            return None;
+        }
         let bin_height = 2.0 * half_height / BINS as f64;
         let balls: usize = self.bins.iter().sum();
         let mut edges = vec![f64::NEG_INFINITY];

@@ -3,28 +3,32 @@
 //!
 //! An impact involves only balls whose paths meet, and within a step a path reaches only so
 //! far from its ball's start, so far-apart parts of the arena have independent timelines.
-//! 1. [`Bands::predict`] cuts the arena into bands of about as many balls each. Each band
-//!    takes the balls starting in it (its own) and those within a halo `HALO_DIAMETERS`
-//!    largest diameters wide on each side, and predicts their impacts as the single
-//!    timeline does (`Timeline::predict`, on the band's balls alone).
+//! 1. [`Bands::predict`] cuts the arena into bands of about as many balls each
+//!    (`layout.rs`). Each band takes the balls starting in it (its own) and those within a
+//!    halo `HALO_DIAMETERS` largest diameters wide on each side, and predicts their impacts
+//!    with the single timeline's code on its balls alone.
 //! 2. [`Bands::run`] runs each band's impacts in time order. The halo's outer balls miss
 //!    their neighbours beyond it, so their histories may be wrong; a wrong history can reach
-//!    the band's own balls only through the halo balls within `Δ` of the band, where `Δ`
-//!    bounds how far apart two balls that may meet start (from each band's cells and how far
-//!    its paths reached, `reach_bound`). So those balls' ends of step are compared, bit for
-//!    bit, with what their own band made of them.
+//!    a band's own balls only through balls starting within `Δ` of its edge, where `Δ`
+//!    bounds how far apart two balls whose paths may meet start (`Timeline::reach_bound`).
+//!    So every ball starting within `Δ` of an edge is compared, bit for bit (hits, position,
+//!    velocity), in the two bands that hold it.
 //! 3. If every comparison holds, every ball takes its own band's end of step, and the hits
-//!    are reported in the order the single timeline takes them (by time, then balls).
-//!    Otherwise — or if a band's step was cut short, began with overlaps or kept paths apart,
-//!    or the resting rule is on — the caller runs the step as one timeline.
+//!    are reported by time, then balls: the single timeline's order, as no band handled an
+//!    impact after a later one. Otherwise — or if a band's step was cut short, began with
+//!    overlaps, stopped a ball against a wall or kept a path apart — the caller runs the step
+//!    as one timeline. Held balls, the resting rule and big balls keep the single timeline.
 //!
 //! The result is the single timeline's whether the bands hold or not, so it never depends on
 //! how many bands (or threads) there are (tested).
 
 use bevy::math::DVec2;
+use bevy::prelude::Resource;
 
+mod band;
 mod layout;
 
+use band::{Band, alike_where};
 use layout::Survey;
 
 use super::impact::wall_code;
@@ -47,10 +51,13 @@ const MAX_BALLS: usize = 400_000;
 /// The halo on each side of a band, in largest diameters.
 const HALO_DIAMETERS: f64 = 10.0;
 
-/// The bands of the current step, kept between steps to reuse their buffers.
-#[derive(Debug, Default)]
+/// The bands of the current step, kept between steps to reuse their buffers: the
+/// continuous mode's second resource beside the [`Timeline`].
+#[derive(Resource, Debug, Default)]
 pub struct Bands {
     bands: Vec<Band>,
+    /// Whether this step is taken in bands.
+    in_use: bool,
     /// Pixels.
     halo: f64,
     /// Steps whose impacts the bands took, and steps run again as one timeline because the
@@ -59,39 +66,20 @@ pub struct Bands {
     pub steps_run_again: u64,
 }
 
-/// One band: its own balls start at `low <= y < high`.
-#[derive(Debug, Default)]
-struct Band {
-    low: f64,
-    high: f64,
-    timeline: Timeline,
-    /// Its balls (own and halo) by their index in the step's input, in increasing order, so
-    /// ties between impacts fall as they do in the single timeline.
-    balls: Vec<u32>,
-    own: Vec<bool>,
-    own_count: usize,
-    circles: Vec<Circle>,
-    velocities: Vec<DVec2>,
-    held: Vec<bool>,
-    stopped: Vec<bool>,
-    /// Its own balls' hits, by input index.
-    hits: Vec<Hit>,
-    /// Its own balls' ball hits, when only counted.
-    ball_hits_counted: u64,
-}
-
-impl Timeline {
+impl Bands {
     /// Stage 2 for a step: in bands for many balls and more than one thread, else as one
-    /// timeline ([`predict`](Self::predict)).
+    /// `timeline` (`Timeline::predict`).
     pub fn predict_step(
         &mut self,
+        timeline: &mut Timeline,
         circles: &[Circle],
         velocities: &[DVec2],
         held: &[bool],
         spec: StepSpec,
     ) {
         let count = Bands::count_for(circles.len());
-        self.predict_in_bands((count, HALO_DIAMETERS), circles, velocities, held, spec);
+        let bands = (count, HALO_DIAMETERS);
+        self.predict_in_bands(bands, timeline, circles, velocities, held, spec);
     }
 
     /// [`predict_step`](Self::predict_step) in `count` bands with halos `halo_diameters`
@@ -99,37 +87,36 @@ impl Timeline {
     fn predict_in_bands(
         &mut self,
         (count, halo_diameters): (usize, f64),
+        timeline: &mut Timeline,
         circles: &[Circle],
         velocities: &[DVec2],
         held: &[bool],
         spec: StepSpec,
     ) {
-        let bands = &mut self.bands;
-        self.banded =
-            count > 1 && bands.predict((count, halo_diameters), circles, velocities, held, spec);
-        if !self.banded {
-            self.predict(circles, velocities, held, spec);
+        let bands = (count, halo_diameters);
+        self.in_use = count > 1 && self.predict(bands, circles, velocities, held, spec);
+        if !self.in_use {
+            timeline.predict(circles, velocities, held, spec);
         }
     }
 
     /// Stage 3 for a step predicted by [`predict_step`](Self::predict_step): what
-    /// [`run`](Self::run) does, in the bands if they were used and hold, else as one timeline
+    /// `Timeline::run` does, in the bands if they were used and hold, else as one `timeline`
     /// (predicted again if need be). Hands every hit to `on_hit` in the order handled, but,
     /// unless `keep_ball_hits`, only counts the ball hits of a step taken in bands: returns
     /// how many it only counted.
     pub fn run_step(
         &mut self,
-        circles: &mut [Circle],
-        velocities: &mut [DVec2],
+        timeline: &mut Timeline,
+        (circles, velocities): (&mut [Circle], &mut [DVec2]),
         (held, stopped): (&mut [bool], &mut [bool]),
         spec: StepSpec,
         keep_ball_hits: bool,
         mut on_hit: impl FnMut(Hit),
     ) -> u64 {
-        if self.banded {
+        if self.in_use {
             let balls = (&mut *held, &mut *stopped);
-            let bands = &mut self.bands;
-            if let Some(counted) = bands.run(
+            if let Some(counted) = self.run(
                 circles,
                 velocities,
                 balls,
@@ -137,18 +124,16 @@ impl Timeline {
                 keep_ball_hits,
                 &mut on_hit,
             ) {
-                self.finish_after_bands(circles, velocities, spec, on_hit);
+                timeline.finish_after_bands(circles, velocities, spec, on_hit);
                 return counted;
             }
             // The bands did not hold: the step as one timeline.
-            self.predict(circles, velocities, held, spec);
+            timeline.predict(circles, velocities, held, spec);
         }
-        self.run(circles, velocities, (held, stopped), spec, on_hit);
+        timeline.run(circles, velocities, (held, stopped), spec, on_hit);
         0
     }
-}
 
-impl Bands {
     /// How many bands a step of `balls` balls takes: one for each thread at work, or 1 (the
     /// single timeline) for few balls, very many, or one thread.
     fn count_for(balls: usize) -> usize {
@@ -170,8 +155,11 @@ impl Bands {
         held: &[bool],
         spec: StepSpec,
     ) -> bool {
-        if spec.rest_speed != 0.0 || count < 2 {
-            return false; // the resting rule sums the walls' stops in the order handled
+        // The resting rule sums the walls' stops in the order handled, and a band of still
+        // balls searches around its flying ones only, as a pile's step does, finding fewer
+        // overlaps than the single timeline's search of every pair.
+        if spec.rest_speed != 0.0 || count < 2 || held.iter().any(|&held| held) {
+            return false;
         }
         let survey = Survey::of(circles, spec.half.y);
         if survey.may_have_big_balls() {
@@ -285,15 +273,19 @@ impl Bands {
     /// Whether every band's result for its own balls is the single timeline's (see the
     /// header).
     fn hold(&self, circles: &[Circle]) -> bool {
-        let plain = self.bands.iter().all(|band| {
+        let none_needs_one_timeline = self.bands.iter().all(|band| {
             let timeline = &band.timeline;
             !timeline.cut_short
+                && !timeline.out_of_order
                 && timeline.overlapping.is_empty()
+                && timeline.resting_wall_impulse == 0.0
                 && !timeline.paths.keeps_some_apart()
         });
-        let reach = self.bands.iter().map(|band| band.timeline.reach_bound());
-        let reach = reach.fold(0.0, f64::max);
-        plain
+        let mut reaches = self.bands.iter().map(|band| band.timeline.reach_bound());
+        let Some(reach) = reaches.try_fold(0.0_f64, |most, reach| Some(most.max(reach?))) else {
+            return false;
+        };
+        none_needs_one_timeline
             && reach <= self.halo
             && self.bands.windows(2).all(|pair| {
                 let near =
@@ -303,100 +295,9 @@ impl Bands {
     }
 }
 
-impl Band {
-    /// Its balls, own and halo, from the step's arrays.
-    fn gather(&mut self, circles: &[Circle], velocities: &[DVec2], held: &[bool], halo: f64) {
-        let (low, high) = (self.low, self.high);
-        self.balls.clear();
-        self.own.clear();
-        self.own_count = 0;
-        for (index, circle) in circles.iter().enumerate() {
-            let y = circle.center.y;
-            if y >= low - halo && y < high + halo {
-                let own = y >= low && y < high;
-                self.balls.push(index as u32);
-                self.own.push(own);
-                self.own_count += usize::from(own);
-            }
-        }
-        let balls = &self.balls;
-        self.circles.clear();
-        self.circles
-            .extend(balls.iter().map(|&index| circles[index as usize]));
-        self.velocities.clear();
-        self.velocities
-            .extend(balls.iter().map(|&index| velocities[index as usize]));
-        self.held.clear();
-        self.held
-            .extend(balls.iter().map(|&index| held[index as usize]));
-    }
-
-    /// Its impacts, each of its own balls' hits kept (ball hits only counted unless
-    /// `keep_ball_hits`).
-    fn run(&mut self, spec: StepSpec, keep_ball_hits: bool) {
-        self.stopped.clear();
-        self.stopped.resize(self.balls.len(), false);
-        self.hits.clear();
-        self.ball_hits_counted = 0;
-        let (balls, own) = (&self.balls, &self.own);
-        let (hits, counted) = (&mut self.hits, &mut self.ball_hits_counted);
-        let mut record = |hit: Hit| {
-            let (first, is_ball_hit) = match hit {
-                Hit::Ball { a, .. } => (a, true),
-                Hit::Wall { ball, .. } => (ball, false),
-            };
-            if !own[first as usize] {
-                return; // the band that owns it records it
-            }
-            if is_ball_hit && !keep_ball_hits {
-                *counted += 1;
-            } else {
-                hits.push(hit.renumbered(|local| balls[local as usize]));
-            }
-        };
-        let arrays = (&mut self.held[..], &mut self.stopped[..]);
-        self.timeline.run_impacts(
-            &mut self.circles,
-            &mut self.velocities,
-            arrays,
-            spec,
-            &mut record,
-        );
-    }
-}
-
-/// Whether `below` and `above` ended the step alike, to the bit, for every ball of both
-/// whose index is `near`.
-fn alike_where(below: &Band, above: &Band, near: impl Fn(u32) -> bool) -> bool {
-    let (mut i, mut j) = (0, 0);
-    while i < below.balls.len() && j < above.balls.len() {
-        let (index_below, index_above) = (below.balls[i], above.balls[j]);
-        if index_below < index_above {
-            i += 1;
-        } else if index_above < index_below {
-            j += 1;
-        } else {
-            if near(index_below) && !same_end(below, i, above, j) {
-                return false;
-            }
-            i += 1;
-            j += 1;
-        }
-    }
-    true
-}
-
-/// Whether ball `i` of `one` and ball `j` of `other` ended the step alike, to the bit.
-fn same_end(one: &Band, i: usize, other: &Band, j: usize) -> bool {
-    let bits = |v: DVec2| (v.x.to_bits(), v.y.to_bits());
-    bits(one.circles[i].center) == bits(other.circles[j].center)
-        && bits(one.velocities[i]) == bits(other.velocities[j])
-        && one.held[i] == other.held[j]
-        && one.stopped[i] == other.stopped[j]
-}
-
-/// A hit's place in the single timeline's order: its time, then its balls' indices (a
-/// wall's code for a wall), as [`Impact`](super::impact::Impact)s are ordered.
+/// A hit's place in the impacts' order: its time, then its balls' indices (a wall's code for
+/// a wall), as [`Impact`](super::impact::Impact)s are ordered. The single timeline hands its
+/// hits on in this order unless it took an impact out of it (`Timeline::out_of_order`).
 fn order_of(hit: &Hit) -> (f64, (u32, u32)) {
     match *hit {
         Hit::Ball { a, b, time, .. } => (time, (a, b)),
@@ -449,15 +350,15 @@ mod tests {
     fn steps(bands: (usize, f64), keep_ball_hits: bool) -> (String, Vec<String>, u64, (u64, u64)) {
         let (mut circles, mut velocities, spec) = gas(6_000);
         let (mut held, mut stopped) = (vec![false; 6_000], vec![false; 6_000]);
-        let mut timeline = Timeline::default();
+        let (mut timeline, mut in_bands) = (Timeline::default(), Bands::default());
         let (mut hits, mut counted) = (Vec::new(), 0);
         for _ in 0..8 {
-            timeline.predict_in_bands(bands, &circles, &velocities, &held, spec);
+            in_bands.predict_in_bands(bands, &mut timeline, &circles, &velocities, &held, spec);
             let flags = (&mut held[..], &mut stopped[..]);
             let record = |hit: Hit| hits.push(format!("{hit:?}"));
-            counted += timeline.run_step(
-                &mut circles,
-                &mut velocities,
+            counted += in_bands.run_step(
+                &mut timeline,
+                (&mut circles, &mut velocities),
                 flags,
                 spec,
                 keep_ball_hits,
@@ -465,44 +366,8 @@ mod tests {
             );
         }
         let state = format!("{circles:?} {velocities:?} {held:?} {stopped:?}");
-        let taken = (
-            timeline.bands.steps_in_bands,
-            timeline.bands.steps_run_again,
-        );
+        let taken = (in_bands.steps_in_bands, in_bands.steps_run_again);
         (state, hits, counted, taken)
-    }
-
-    #[test]
-    fn two_bands_are_alike_only_if_every_ball_near_their_edge_ended_alike_to_the_bit() {
-        let band = |balls: Vec<u32>, x: &[f64], vx: &[f64]| Band {
-            balls,
-            circles: x
-                .iter()
-                .map(|&x| Circle::new(DVec2::new(x, 0.0), 1.0))
-                .collect(),
-            velocities: vx.iter().map(|&vx| DVec2::new(vx, 0.0)).collect(),
-            held: vec![false; x.len()],
-            stopped: vec![false; x.len()],
-            ..Band::default()
-        };
-        // Balls 2 and 4 are in both; 4 ended elsewhere, 2 with -0 for 0 px/s.
-        let below = band(
-            vec![1, 2, 4, 7],
-            &[1.0, 2.0, 4.0, 7.0],
-            &[0.0, 0.0, 1.0, 0.0],
-        );
-        let above = band(
-            vec![2, 3, 4, 9],
-            &[2.0, 3.0, 4.5, 9.0],
-            &[-0.0, 0.0, 1.0, 0.0],
-        );
-        assert!(alike_where(&below, &above, |index| index == 3 || index == 7));
-        assert!(!alike_where(&below, &above, |index| index == 4));
-        assert!(!alike_where(&below, &above, |index| index == 2));
-        let mut same_ends = band(vec![2, 4], &[2.0, 4.0], &[0.0, 1.0]);
-        assert!(alike_where(&below, &same_ends, |_| true));
-        same_ends.stopped[1] = true;
-        assert!(!alike_where(&below, &same_ends, |_| true));
     }
 
     #[test]
@@ -529,5 +394,52 @@ mod tests {
             .collect();
         assert!(counting.0 == state);
         assert_eq!((counting.1, counting.2 as usize), (wall_hits, ball_hits));
+    }
+
+    #[test]
+    fn a_timeline_notices_when_it_takes_an_impact_after_a_later_one() {
+        // Ball 1 rests touching ball 0; ball 2 hits ball 1, which meets ball 0 at that very
+        // moment: the impact of balls 0 and 1 comes before that of 1 and 2 in the impacts' order.
+        let circles = [
+            Circle::new(DVec2::new(-10.0, 0.0), 5.0),
+            Circle::new(DVec2::ZERO, 5.0),
+            Circle::new(DVec2::new(12.0, 0.0), 5.0),
+        ];
+        let fling = DVec2::new(-600.0, 0.0);
+        let mut velocities = [DVec2::ZERO, DVec2::ZERO, fling];
+        let spec = StepSpec {
+            dt: 1.0 / 60.0,
+            half: DVec2::splat(500.0),
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+            gravity: DVec2::ZERO,
+            rest_speed: 0.0,
+        };
+        let (mut held, mut stopped) = ([false; 3], [false; 3]);
+        let mut timeline = Timeline::default();
+        timeline.predict(&circles, &velocities, &held, spec);
+        let mut hits = Vec::new();
+        let mut moved = circles;
+        let flags = (&mut held[..], &mut stopped[..]);
+        timeline.run_impacts(&mut moved, &mut velocities, flags, spec, &mut |hit| {
+            hits.push(order_of(&hit))
+        });
+        let keys: Vec<(u32, u32)> = hits.iter().map(|&(_, key)| key).collect();
+        assert_eq!(keys, [(1, 2), (0, 1)]);
+        assert_eq!(hits[0].0, hits[1].0);
+        assert!((hits[0].0 - 1.0 / 300.0).abs() < 1e-12, "{hits:?}");
+        assert!(timeline.out_of_order);
+        // Without ball 0, nothing is out of order.
+        let mut timeline = Timeline::default();
+        let (circles, mut velocities) = ([circles[1], circles[2]], [DVec2::ZERO, fling]);
+        timeline.predict(&circles, &velocities, &held[..2], spec);
+        let mut moved = circles;
+        let flags = (&mut held[..2], &mut stopped[..2]);
+        let mut count = 0;
+        timeline.run_impacts(&mut moved, &mut velocities, flags, spec, &mut |_| {
+            count += 1
+        });
+        assert_eq!(count, 1);
+        assert!(!timeline.out_of_order);
     }
 }

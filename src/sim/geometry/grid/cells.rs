@@ -16,6 +16,9 @@ pub struct CellMap {
     inverse_cell_size: f64,
     pub columns: usize,
     pub rows: usize,
+    /// Whether the cap on cells left the rectangle's last columns or rows to share the border
+    /// cells (see [`cell_index`](Self::cell_index)).
+    pub capped: bool,
 }
 
 impl CellMap {
@@ -30,13 +33,18 @@ impl CellMap {
             .max(f64::MIN_POSITIVE);
         // The caps only bind for non-finite extents; clamping cells together never separates
         // two touching balls by more than one cell, so no pair is lost.
-        let columns = cells_along(extent.x, cell_size).min(max_cells);
-        let rows = cells_along(extent.y, cell_size).min((max_cells / columns).max(1));
+        let (columns_needed, rows_needed) = (
+            cells_along(extent.x, cell_size),
+            cells_along(extent.y, cell_size),
+        );
+        let columns = columns_needed.min(max_cells);
+        let rows = rows_needed.min((max_cells / columns).max(1));
         Self {
             origin: min,
             inverse_cell_size: 1.0 / cell_size,
             columns,
             rows,
+            capped: columns < columns_needed || rows < rows_needed,
         }
     }
 

@@ -224,6 +224,12 @@ impl UniformGrid {
         self.cells.cell_size()
     }
 
+    /// Whether each ball in the cells lies in its own cell: no cap on the number of cells
+    /// made the border cells hold balls beyond them.
+    pub fn cells_hold_their_balls(&self) -> bool {
+        !self.cells.capped
+    }
+
     /// Number of balls sorted in.
     pub fn len(&self) -> usize {
         self.sorted_index.len()
