@@ -45,7 +45,7 @@ use crate::sim::report::Hit;
 const MIN_BALLS: usize = PARALLEL_MIN_BALLS;
 
 /// Above this many balls the step is one timeline: each band's buffers are its own, and at a
-/// million balls the bands' together passed the memory target (524 against 369 MB).
+/// million balls the bands' together passed the memory target (524 against 369 MiB).
 const MAX_BALLS: usize = 400_000;
 
 /// The halo on each side of a band, in largest diameters.
