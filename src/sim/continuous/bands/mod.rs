@@ -18,6 +18,8 @@
 //!    impact after a later one. Otherwise — or if a band's step was cut short, began with
 //!    overlaps, stopped a ball against a wall or kept a path apart — the caller runs the step
 //!    as one timeline. Held balls, the resting rule and big balls keep the single timeline.
+//!    After bands that miss, the next steps are taken as one timeline (1, then 2, 4, … up to
+//!    `MOST_STEPS_WITHOUT_BANDS` after misses in a row) before the bands are tried again.
 //!
 //! The result is the single timeline's whether the bands hold or not, so it never depends on
 //! how many bands (or threads) there are (tested).
@@ -51,6 +53,11 @@ const MAX_BALLS: usize = 400_000;
 /// The halo on each side of a band, in largest diameters.
 const HALO_DIAMETERS: f64 = 10.0;
 
+/// After bands that did not hold, the steps taken as one timeline before trying them again
+/// double with each miss in a row, up to this many (a second at 60 steps a second): a step
+/// run twice costs more than the bands save, and what made them miss (a crowd, say) lasts.
+const MOST_STEPS_WITHOUT_BANDS: u32 = 64;
+
 /// The bands of the current step, kept between steps to reuse their buffers: the
 /// continuous mode's second resource beside the [`Timeline`].
 #[derive(Resource, Debug, Default)]
@@ -58,6 +65,10 @@ pub struct Bands {
     bands: Vec<Band>,
     /// Whether this step is taken in bands.
     in_use: bool,
+    /// Steps left to take as one timeline before trying the bands again, and how many the
+    /// next miss sets (see [`MOST_STEPS_WITHOUT_BANDS`]).
+    steps_without: u32,
+    next_steps_without: u32,
     /// Pixels.
     halo: f64,
     /// Steps whose impacts the bands took, and steps run again as one timeline because the
@@ -94,7 +105,9 @@ impl Bands {
         spec: StepSpec,
     ) {
         let bands = (count, halo_diameters);
-        self.in_use = count > 1 && self.predict(bands, circles, velocities, held, spec);
+        let waited = self.steps_without == 0;
+        self.steps_without = self.steps_without.saturating_sub(1);
+        self.in_use = count > 1 && waited && self.predict(bands, circles, velocities, held, spec);
         if !self.in_use {
             timeline.predict(circles, velocities, held, spec);
         }
@@ -210,9 +223,12 @@ impl Bands {
         });
         if !self.hold(circles) {
             self.steps_run_again += 1;
+            self.steps_without = self.next_steps_without.max(1);
+            self.next_steps_without = (2 * self.steps_without).min(MOST_STEPS_WITHOUT_BANDS);
             return None;
         }
         self.steps_in_bands += 1;
+        self.next_steps_without = 1;
         self.write_own_ends(circles, velocities, (held, stopped));
         let mut hits = Vec::new();
         let mut counted = 0;
@@ -381,10 +397,11 @@ mod tests {
         assert!(held.0 == state, "the balls differ");
         assert!(held.1 == hits, "the hits differ");
         assert_eq!((held.2, held.3), (0, (8, 0)));
-        // Halos too narrow to hold: every step is run again as one timeline.
+        // Halos too narrow to hold: steps 1, 3 and 6 are run again as one timeline, the others
+        // wait out one and then two steps without bands.
         let narrow = steps((3, 1.5), true);
         assert!(narrow.0 == state && narrow.1 == hits);
-        assert_eq!(narrow.3, (0, 8));
+        assert_eq!(narrow.3, (0, 3));
         // Ball hits only counted: as many, and the wall hits alone, in order.
         let counting = steps((3, HALO_DIAMETERS), false);
         let wall_hits: Vec<String> = hits
