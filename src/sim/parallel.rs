@@ -1,7 +1,9 @@
 //! The stages' parallel parts: work cut into pieces fixed by the input alone (never by the
 //! number of threads), run on bevy's compute pool when there is enough of it and more than
 //! one thread, their results joined in the pieces' order. So every result, down to the
-//! rounding of a sum, is the same whatever the thread count.
+//! rounding of a sum, is the same whatever the thread count. (The continuous mode's bands,
+//! one per thread, keep that by giving the single timeline's result exactly; each runs on
+//! one thread, [`one_thread_each`].)
 
 use std::ops::Range;
 

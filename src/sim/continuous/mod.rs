@@ -16,9 +16,10 @@
 //!   every ball to the end of the step, and the balls written back.
 //!
 //! From 20,000 to 400,000 balls with more than one thread, both stages take the step in
-//! horizontal bands of the arena, one timeline each, at once (`bands/`): each band checks that
-//! what its edge balls did matches what the band beside made of them, so the result is the
-//! single timeline's to the bit, or the step is run again as one.
+//! horizontal bands of the arena, one timeline each, at once (`bands/`): the balls near each
+//! edge must end alike in the two bands beside it, so the result is the single timeline's to
+//! the bit, or the step is run again as one (and the next few are, backing off). Held balls,
+//! the resting rule and big balls keep the single timeline.
 //!
 //! [`state`] holds the [`Timeline`] resource both halves work on; the [`Bands`] resource
 //! holds the bands' own timelines.

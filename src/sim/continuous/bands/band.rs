@@ -1,5 +1,6 @@
 //! One band of the step: its balls (own and halo) gathered from the step's arrays, its
-//! timeline run, and the check that two bands ended their shared balls alike.
+//! timeline run (each on one thread of the compute pool, not split within), and the check,
+//! on the calling thread, that two bands ended their shared balls alike.
 
 use bevy::math::DVec2;
 
@@ -24,7 +25,8 @@ pub(super) struct Band {
     pub(super) stopped: Vec<bool>,
     /// How many hits each of its balls took.
     pub(super) hit_counts: Vec<u32>,
-    /// Its own balls' hits, by input index.
+    /// The hits whose first ball (the lower index, or the one at a wall) is its own, by
+    /// input index.
     pub(super) hits: Vec<Hit>,
     /// Its own balls' ball hits, when only counted.
     pub(super) ball_hits_counted: u64,

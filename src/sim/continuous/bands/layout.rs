@@ -1,5 +1,6 @@
 //! Where the bands' edges go: a survey of the balls (their largest and mean radius, how many
-//! start at each height) and edges that give every band about as many balls.
+//! start at each height; in pieces on the compute pool for many balls) and edges that give
+//! every band about as many balls (on the calling thread).
 
 use crate::sim::geometry::Circle;
 use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};

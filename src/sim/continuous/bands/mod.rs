@@ -22,7 +22,8 @@
 //!    `MOST_STEPS_WITHOUT_BANDS` after misses in a row) before the bands are tried again.
 //!
 //! The result is the single timeline's whether the bands hold or not, so it never depends on
-//! how many bands (or threads) there are (tested).
+//! how many bands (or threads) there are (tested) — short of a wrong history that ends, in
+//! every ball compared, with the same hits, position and velocity to the bit.
 
 use bevy::math::DVec2;
 use bevy::prelude::Resource;
@@ -94,7 +95,8 @@ impl Bands {
     }
 
     /// [`predict_step`](Self::predict_step) in `count` bands with halos `halo_diameters`
-    /// largest diameters wide (one timeline if `count` is 1, or if they cannot be used).
+    /// largest diameters wide (one timeline if `count` is 1, while backing off after a miss,
+    /// or if they cannot be used).
     fn predict_in_bands(
         &mut self,
         (count, halo_diameters): (usize, f64),
@@ -115,9 +117,9 @@ impl Bands {
 
     /// Stage 3 for a step predicted by [`predict_step`](Self::predict_step): what
     /// `Timeline::run` does, in the bands if they were used and hold, else as one `timeline`
-    /// (predicted again if need be). Hands every hit to `on_hit` in the order handled, but,
-    /// unless `keep_ball_hits`, only counts the ball hits of a step taken in bands: returns
-    /// how many it only counted.
+    /// (predicted again if need be). Hands every hit to `on_hit` in the single timeline's
+    /// order, but, unless `keep_ball_hits`, only counts the ball hits of a step taken in
+    /// bands: returns how many it only counted.
     pub fn run_step(
         &mut self,
         timeline: &mut Timeline,
@@ -302,7 +304,7 @@ impl Bands {
             return false;
         };
         none_needs_one_timeline
-            && reach <= self.halo
+            && reach < self.halo
             && self.bands.windows(2).all(|pair| {
                 let near =
                     |index: u32| (circles[index as usize].center.y - pair[0].high).abs() <= reach;
@@ -398,7 +400,7 @@ mod tests {
         assert!(held.1 == hits, "the hits differ");
         assert_eq!((held.2, held.3), (0, (8, 0)));
         // Halos too narrow to hold: steps 1, 3 and 6 are run again as one timeline, the others
-        // wait out one and then two steps without bands.
+        // are the back-off's one, two and four steps without bands (the last cut short).
         let narrow = steps((3, 1.5), true);
         assert!(narrow.0 == state && narrow.1 == hits);
         assert_eq!(narrow.3, (0, 3));
