@@ -14,13 +14,15 @@ pub struct Survey {
     pub largest: f64,
     mean: f64,
     bins: Vec<usize>,
+    /// Half the arena's height; the bins cover `[-half_height, half_height]`.
+    half_height: f64,
 }
 
 impl Survey {
     /// The balls in `circles`, in the arena's height `[-half_height, half_height]`; in pieces
     /// on the compute pool for many balls.
     pub fn of(circles: &[Circle], half_height: f64) -> Self {
-        let bin_height = 2.0 * half_height / BINS as f64;
+        let bin_height = bin_height(half_height);
         let bin_of = |y: f64| (((y + half_height) / bin_height).max(0.0) as usize).min(BINS - 1);
         let pieces = in_pieces(
             circles.chunks(BALLS_PER_PIECE),
@@ -40,6 +42,7 @@ impl Survey {
             largest: 0.0,
             mean: 0.0,
             bins: vec![0; BINS],
+            half_height,
         };
         for (sum, largest, bins) in pieces {
             survey.mean += sum;
@@ -62,11 +65,11 @@ impl Survey {
 
     /// The edges of `count` bands of about as many balls each over the arena's height, the
     /// outer ones open (`-inf`, `+inf`); `None` if some band would be no taller than `halo`.
-    pub fn edges(&self, count: usize, half_height: f64, halo: f64) -> Option<Vec<f64>> {
+    pub fn edges(&self, count: usize, halo: f64) -> Option<Vec<f64>> {
         if count < 2 {
             return None;
         }
-        let bin_height = 2.0 * half_height / BINS as f64;
+        let (half_height, bin_height) = (self.half_height, bin_height(self.half_height));
         let balls: usize = self.bins.iter().sum();
         let mut edges = vec![f64::NEG_INFINITY];
         let mut below = 0;
@@ -90,6 +93,11 @@ impl Survey {
     }
 }
 
+/// The height of each of [`BINS`] bins over `[-half_height, half_height]`.
+fn bin_height(half_height: f64) -> f64 {
+    2.0 * half_height / BINS as f64
+}
+
 #[cfg(test)]
 mod tests {
     use bevy::math::DVec2;
@@ -107,7 +115,7 @@ mod tests {
             .collect();
         let survey = Survey::of(&circles, 500.0);
         assert_eq!((survey.largest, survey.may_have_big_balls()), (2.0, false));
-        let edges = survey.edges(4, 500.0, 50.0).unwrap();
+        let edges = survey.edges(4, 50.0).unwrap();
         assert_eq!(edges.len(), 5);
         assert_eq!((edges[0], edges[4]), (f64::NEG_INFINITY, f64::INFINITY));
         for band in edges.windows(2) {
@@ -119,6 +127,6 @@ mod tests {
         }
         // The top band is the crowded tenth, too thin for a halo of 100 px.
         assert!(edges[3] > 400.0);
-        assert_eq!(survey.edges(4, 500.0, 100.0), None);
+        assert_eq!(survey.edges(4, 100.0), None);
     }
 }

@@ -99,17 +99,16 @@ impl Bands {
     /// or if they cannot be used).
     fn predict_in_bands(
         &mut self,
-        (count, halo_diameters): (usize, f64),
+        bands: (usize, f64),
         timeline: &mut Timeline,
         circles: &[Circle],
         velocities: &[DVec2],
         held: &[bool],
         spec: StepSpec,
     ) {
-        let bands = (count, halo_diameters);
         let waited = self.steps_without == 0;
         self.steps_without = self.steps_without.saturating_sub(1);
-        self.in_use = count > 1 && waited && self.predict(bands, circles, velocities, held, spec);
+        self.in_use = waited && self.predict(bands, circles, velocities, held, spec);
         if !self.in_use {
             timeline.predict(circles, velocities, held, spec);
         }
@@ -181,7 +180,7 @@ impl Bands {
             return false;
         }
         self.halo = halo_diameters * 2.0 * survey.largest;
-        let Some(edges) = survey.edges(count, spec.half.y, self.halo) else {
+        let Some(edges) = survey.edges(count, self.halo) else {
             return false;
         };
         self.bands.resize_with(count, Band::default);
