@@ -35,6 +35,17 @@ impl ImpactQueue {
         self.later.push(Reverse(impact));
     }
 
+    /// The step's first prediction `distance` places after the next one left: most likely
+    /// taken soon (an impact predicted since may come first, or make it stale).
+    pub fn ahead(&self, distance: usize) -> Option<&Impact> {
+        self.sorted.get(self.next + distance)
+    }
+
+    /// The earliest impact predicted during the step: it may be taken next.
+    pub fn earliest_later(&self) -> Option<&Impact> {
+        self.later.peek().map(|Reverse(impact)| impact)
+    }
+
     /// Takes the earliest impact left.
     pub fn pop(&mut self) -> Option<Impact> {
         let first = self.sorted.get(self.next);

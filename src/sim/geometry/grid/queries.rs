@@ -1,10 +1,15 @@
 //! The grid's queries around a place: the cells of a box, and the balls that may touch a
 //! circle, the big ones (kept apart in a grid of their own) included. The continuous mode
 //! searches around its flying balls with the second, and its `Paths` read the cells of a box
-//! and the big balls' part for each ball an impact redirects.
+//! and the big balls' part for each ball an impact redirects. Last, the loads that bring a
+//! ball's place into the cache ahead of such a query.
 
 use bevy::math::DVec2;
 
+use std::hint::black_box;
+use std::ops::Range;
+
+use super::counting::NO_CELL;
 use super::uniform::UniformGrid;
 use crate::sim::geometry::circle::Circle;
 
@@ -44,6 +49,50 @@ impl UniformGrid {
 
     fn visit_may_touch_dyn(&self, circle: Circle, visit: &mut dyn FnMut(u32, Circle)) {
         self.for_each_that_may_touch(circle, visit);
+    }
+
+    /// Loads what a query around the ball in `slot` reads first, its cell and circle, so
+    /// that they are in the cache when the query comes (after
+    /// [`renumber_by_slot`](Self::renumber_by_slot)). Safe Rust has no prefetch instruction:
+    /// a load whose value goes to [`black_box`] cannot be dropped by the optimiser, and the
+    /// processor starts it at once while it works on whatever comes before the query.
+    pub fn prefetch_slot(&self, slot: usize) {
+        black_box(self.cell_of.get(slot).copied());
+        black_box(self.sorted_circle.get(slot).copied());
+    }
+
+    /// Loads the first circle of each row of cells around the ball in `slot` (its cell's row
+    /// and the rows beside it, three cells wide), as [`prefetch_slot`](Self::prefetch_slot)
+    /// does: where a query around the ball will read. Best some time after `prefetch_slot`,
+    /// which loads the ball's cell, read here.
+    pub fn prefetch_cells_around(&self, slot: usize) {
+        for cells in self.cell_runs_around(slot) {
+            let first_slot = self.cell_start[cells.start] as usize;
+            black_box(self.sorted_circle.get(first_slot).copied());
+        }
+    }
+
+    /// The cells around the ball in `slot` (after [`renumber_by_slot`](Self::renumber_by_slot)):
+    /// its cell's row and the rows beside it, each a run of three cells centred on its column
+    /// (fewer at the grid's edges). None for a big ball, or a slot past the last.
+    fn cell_runs_around(&self, slot: usize) -> impl Iterator<Item = Range<usize>> + use<> {
+        let cell = self
+            .cell_of
+            .get(slot)
+            .copied()
+            .filter(|&cell| cell != NO_CELL);
+        let (columns, rows) = (self.cells.columns, self.cells.rows);
+        let (row, column) = cell.map_or((0, 0), |cell| {
+            (cell as usize / columns, cell as usize % columns)
+        });
+        let near_rows = if cell.is_some() {
+            row.saturating_sub(1)..(row + 2).min(rows)
+        } else {
+            0..0
+        };
+        let near_columns = column.saturating_sub(1)..(column + 2).min(columns);
+        near_rows
+            .map(move |row| row * columns + near_columns.start..row * columns + near_columns.end)
     }
 
     /// The balls in the cells that overlap the box `[min, max]`.
@@ -135,6 +184,40 @@ mod tests {
                 assert!(visited.contains(&(k as u32)), "missed {k}");
             }
         }
+    }
+
+    #[test]
+    fn the_cells_prefetched_around_a_ball_hold_it_and_its_neighbours_rows() {
+        let circles = mixed_sizes();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        grid.renumber_by_slot(&mut Vec::new());
+        let (columns, rows) = (grid.cells.columns, grid.cells.rows);
+        assert!(columns > 3 && rows > 3, "{columns} x {rows} cells");
+        let mut inner = 0;
+        for slot in 0..grid.small_count() {
+            let cell = grid.cell_of[slot] as usize;
+            let runs: Vec<Range<usize>> = grid.cell_runs_around(slot).collect();
+            assert!(runs.iter().any(|run| run.contains(&cell)), "slot {slot}");
+            let (row, column) = (cell / columns, cell % columns);
+            let inside = |k: usize, last: usize| usize::from(k > 0) + usize::from(k < last);
+            assert_eq!(runs.len(), 1 + inside(row, rows - 1), "slot {slot}");
+            for run in &runs {
+                assert_eq!(run.len(), 1 + inside(column, columns - 1), "slot {slot}");
+                assert_eq!(run.start / columns, (run.end - 1) / columns, "one row");
+            }
+            inner += usize::from(runs.len() == 3 && runs[0].len() == 3);
+            grid.prefetch_slot(slot);
+            grid.prefetch_cells_around(slot);
+        }
+        assert!(inner > 0);
+        // Big balls have no cell, and a slot past the last is nothing: both load nothing.
+        for slot in grid.small_count()..grid.len() + 3 {
+            assert_eq!(grid.cell_runs_around(slot).count(), 0, "slot {slot}");
+            grid.prefetch_slot(slot);
+            grid.prefetch_cells_around(slot);
+        }
+        assert!(grid.small_count() < grid.len(), "some big balls");
     }
 
     /// Whether a query around `probe` grown by `reach` reads the cell of `slot`.

@@ -36,7 +36,7 @@ pub struct UniformGrid {
     pub(super) sorted_circle: Vec<Circle>,
     /// Each ball's cell ([`NO_CELL`] for a big one): by its index while sorting, by its slot
     /// after [`renumber_by_slot`](Self::renumber_by_slot).
-    cell_of: Vec<u32>,
+    pub(super) cell_of: Vec<u32>,
     /// Slots `0..small_count` are in the cells; the rest are the big balls.
     pub(super) small_count: usize,
     /// Largest radius of a ball in the cells.
