@@ -65,27 +65,41 @@ impl UniformGrid {
     /// [`rebuild`](Self::rebuild) with the `count` circles made by `circle_at(index)` (each
     /// made a few times), for a caller that would otherwise keep a copy of them only to sort.
     pub fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle + Sync) {
-        // One sum in the balls' order, so the mean's rounding never depends on how the work
-        // is cut; every other pass over the balls runs in pieces, on the compute pool for many.
-        let radius_sum: f64 = (0..count).map(|ball| circle_at(ball).radius).sum();
+        // The extent, the radii's sum and the largest radius in one pass, in pieces (on the
+        // compute pool for many balls): the pieces' sums are added in their order, and a
+        // piece's size is fixed, so the mean's rounding never depends on the threads.
+        let parallel = worth_splitting(count);
+        let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
+            let mut piece = (DVec2::MAX, DVec2::MIN, 0.0, 0.0_f64);
+            for circle in balls.map(&circle_at) {
+                piece.0 = piece.0.min(circle.center);
+                piece.1 = piece.1.max(circle.center);
+                piece.2 += circle.radius;
+                piece.3 = piece.3.max(circle.radius);
+            }
+            piece
+        });
+        let (mut min, mut max, radius_sum, largest) =
+            by_piece
+                .into_iter()
+                .fold((DVec2::MAX, DVec2::MIN, 0.0, 0.0_f64), |all, piece| {
+                    let (min, max) = (all.0.min(piece.0), all.1.max(piece.1));
+                    (min, max, all.2 + piece.2, all.3.max(piece.3))
+                });
         self.big_limit = BIG_RADIUS_FACTOR * radius_sum / count.max(1) as f64;
         let big_limit = self.big_limit;
-        let parallel = worth_splitting(count);
-        let bounds = in_pieces(piece_ranges(count), parallel, |balls| {
-            let (mut min, mut max, mut largest_radius) = (DVec2::MAX, DVec2::MIN, 0.0_f64);
-            for circle in balls.map(&circle_at) {
-                min = min.min(circle.center);
-                max = max.max(circle.center);
-                if !is_big(circle.radius, big_limit) {
-                    largest_radius = largest_radius.max(circle.radius);
-                }
-            }
-            (min, max, largest_radius)
-        });
-        let (mut min, mut max, largest_radius) = bounds.into_iter().fold(
-            (DVec2::MAX, DVec2::MIN, 0.0_f64),
-            |(min, max, largest), piece| (min.min(piece.0), max.max(piece.1), largest.max(piece.2)),
-        );
+        // With big balls, the largest of the others takes another pass.
+        let largest_radius = if largest <= big_limit {
+            largest
+        } else {
+            let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
+                balls
+                    .map(&circle_at)
+                    .filter(|circle| !is_big(circle.radius, big_limit))
+                    .fold(0.0_f64, |largest, circle| largest.max(circle.radius))
+            });
+            by_piece.into_iter().fold(0.0_f64, f64::max)
+        };
         if count == 0 {
             (min, max) = (DVec2::ZERO, DVec2::ZERO);
         }
