@@ -4,10 +4,10 @@
 //! and the big balls' part for each ball an impact redirects. Last, the loads that bring a
 //! ball's place into the cache ahead of such a query.
 
-use bevy::math::DVec2;
-
 use std::hint::black_box;
 use std::ops::Range;
+
+use bevy::math::DVec2;
 
 use super::counting::NO_CELL;
 use super::uniform::UniformGrid;
