@@ -114,7 +114,8 @@ impl Timeline {
 
     /// Loads the movers of `impact`'s balls and the first one's slot in the grid.
     fn prefetch_balls(&self, impact: Impact) {
-        // A mover spans two cache lines: a field near each end loads both.
+        // A mover spans two cache lines: its first field and its last but one load both
+        // (its layout is fixed: `repr(C)`).
         let load =
             |slot: u32| black_box(self.movers.get(slot as usize).map(|m| (m.center, m.hits)));
         load(impact.a);

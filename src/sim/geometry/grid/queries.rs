@@ -53,9 +53,11 @@ impl UniformGrid {
 
     /// Loads what a query around the ball in `slot` reads first, its cell and circle, so
     /// that they are in the cache when the query comes (after
-    /// [`renumber_by_slot`](Self::renumber_by_slot)). Safe Rust has no prefetch instruction:
-    /// a load whose value goes to [`black_box`] cannot be dropped by the optimiser, and the
-    /// processor starts it at once while it works on whatever comes before the query.
+    /// [`renumber_by_slot`](Self::renumber_by_slot)). Safe Rust has no prefetch instruction,
+    /// so this is a plain load whose value goes to [`black_box`], which keeps the optimiser
+    /// from dropping it: the processor starts it at once and goes on with the instructions
+    /// that follow (a few hundred, its reorder window) while the miss is served, so misses
+    /// overlap with work instead of being waited for one at a time.
     pub fn prefetch_slot(&self, slot: usize) {
         black_box(self.cell_of.get(slot).copied());
         black_box(self.sorted_circle.get(slot).copied());
@@ -67,14 +69,14 @@ impl UniformGrid {
     /// which loads the ball's cell, read here.
     pub fn prefetch_cells_around(&self, slot: usize) {
         for cells in self.cell_runs_around(slot) {
-            let first_slot = self.cell_start[cells.start] as usize;
-            black_box(self.sorted_circle.get(first_slot).copied());
+            let first_slot = self.cell_start.get(cells.start).map(|&slot| slot as usize);
+            black_box(first_slot.and_then(|slot| self.sorted_circle.get(slot).copied()));
         }
     }
 
     /// The cells around the ball in `slot` (after [`renumber_by_slot`](Self::renumber_by_slot)):
     /// its cell's row and the rows beside it, each a run of three cells centred on its column
-    /// (fewer at the grid's edges). None for a big ball, or a slot past the last.
+    /// (fewer at the grid's edges). No runs for a big ball, or a slot past the last.
     fn cell_runs_around(&self, slot: usize) -> impl Iterator<Item = Range<usize>> + use<> {
         let cell = self
             .cell_of

@@ -51,6 +51,46 @@ pub struct UniformGrid {
     big_rows: RowLists,
 }
 
+/// What a pass over some balls finds: the box of their centres, the sum of their radii and
+/// the largest radius.
+#[derive(Clone, Copy)]
+struct Extent {
+    min: DVec2,
+    max: DVec2,
+    radius_sum: f64,
+    largest_radius: f64,
+}
+
+impl Extent {
+    /// No ball yet.
+    const NONE: Self = Self {
+        min: DVec2::MAX,
+        max: DVec2::MIN,
+        radius_sum: 0.0,
+        largest_radius: 0.0,
+    };
+
+    /// With `circle` too.
+    fn with(self, circle: Circle) -> Self {
+        self.joined(Self {
+            min: circle.center,
+            max: circle.center,
+            radius_sum: circle.radius,
+            largest_radius: circle.radius,
+        })
+    }
+
+    /// Both passes' balls, `self`'s first (the sums are added in that order).
+    fn joined(self, other: Self) -> Self {
+        Self {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+            radius_sum: self.radius_sum + other.radius_sum,
+            largest_radius: self.largest_radius.max(other.largest_radius),
+        }
+    }
+}
+
 /// Whether a ball of `radius` is big where the limit is `big_limit`. A NaN is not big.
 fn is_big(radius: f64, big_limit: f64) -> bool {
     radius > big_limit
@@ -70,27 +110,15 @@ impl UniformGrid {
         // piece's size is fixed, so the mean's rounding never depends on the threads.
         let parallel = worth_splitting(count);
         let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
-            let mut piece = (DVec2::MAX, DVec2::MIN, 0.0, 0.0_f64);
-            for circle in balls.map(&circle_at) {
-                piece.0 = piece.0.min(circle.center);
-                piece.1 = piece.1.max(circle.center);
-                piece.2 += circle.radius;
-                piece.3 = piece.3.max(circle.radius);
-            }
-            piece
+            balls.map(&circle_at).fold(Extent::NONE, Extent::with)
         });
-        let (mut min, mut max, radius_sum, largest) =
-            by_piece
-                .into_iter()
-                .fold((DVec2::MAX, DVec2::MIN, 0.0, 0.0_f64), |all, piece| {
-                    let (min, max) = (all.0.min(piece.0), all.1.max(piece.1));
-                    (min, max, all.2 + piece.2, all.3.max(piece.3))
-                });
+        let all = by_piece.into_iter().fold(Extent::NONE, Extent::joined);
+        let (mut min, mut max, radius_sum) = (all.min, all.max, all.radius_sum);
         self.big_limit = BIG_RADIUS_FACTOR * radius_sum / count.max(1) as f64;
         let big_limit = self.big_limit;
         // With big balls, the largest of the others takes another pass.
-        let largest_radius = if largest <= big_limit {
-            largest
+        let largest_radius = if all.largest_radius <= big_limit {
+            all.largest_radius
         } else {
             let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
                 balls
