@@ -76,7 +76,10 @@ impl UniformGrid {
 
     /// The cells around the ball in `slot` (after [`renumber_by_slot`](Self::renumber_by_slot)):
     /// its cell's row and the rows beside it, each a run of three cells centred on its column
-    /// (fewer at the grid's edges). No runs for a big ball, or a slot past the last.
+    /// (fewer at the grid's edges). No runs for a big ball, or a slot past the last. From the
+    /// ball's cell, not its current circle through
+    /// [`for_each_cell_run_in_box`](Self::for_each_cell_run_in_box): that was 3% slower at a
+    /// million balls (seven rounds).
     fn cell_runs_around(&self, slot: usize) -> impl Iterator<Item = Range<usize>> + use<> {
         let cell = self
             .cell_of
@@ -188,12 +191,17 @@ mod tests {
         }
     }
 
+    /// `circles` in a grid that numbers them by slot.
+    fn renumbered(circles: &[Circle]) -> UniformGrid {
+        let mut grid = UniformGrid::default();
+        grid.rebuild(circles);
+        grid.renumber_by_slot(&mut Vec::new());
+        grid
+    }
+
     #[test]
     fn the_cells_prefetched_around_a_ball_hold_it_and_its_neighbours_rows() {
-        let circles = mixed_sizes();
-        let mut grid = UniformGrid::default();
-        grid.rebuild(&circles);
-        grid.renumber_by_slot(&mut Vec::new());
+        let grid = renumbered(&mixed_sizes());
         let (columns, rows) = (grid.cells.columns, grid.cells.rows);
         assert!(columns > 3 && rows > 3, "{columns} x {rows} cells");
         let mut inner = 0;
@@ -235,9 +243,7 @@ mod tests {
     #[test]
     fn a_circle_put_in_a_slot_is_found_by_a_query_grown_by_its_reach_from_the_cell() {
         let circles = scattered();
-        let mut grid = UniformGrid::default();
-        grid.rebuild(&circles);
-        grid.renumber_by_slot(&mut Vec::new());
+        let grid = renumbered(&circles);
         let (mut missed_by_radius_alone, mut cases) = (0, 0);
         for k in 0..4000_usize {
             let slot = k * 7 % grid.small_count();
