@@ -12,7 +12,8 @@
 //!   wall time of impact within the step, found through the grid of swept circles
 //!   ([`impact`] holds what a prediction is);
 //! - stage 3, [`run_timeline`] ([`timeline`]): the impacts in time order, predicting anew for
-//!   the balls each one redirects (`paths.rs` keeps every ball's current path by slot), then
+//!   the balls each one redirects (`repredict.rs`; `paths.rs` keeps every ball's current path
+//!   by slot), then
 //!   every ball to the end of the step, and the balls written back.
 //!
 //! From 20,000 to 400,000 balls with more than one thread, both stages take the step in
@@ -31,6 +32,7 @@ pub mod impact;
 mod paths;
 pub mod predict;
 mod queue;
+mod repredict;
 pub mod state;
 pub mod timeline;
 

@@ -79,6 +79,12 @@ impl Paths {
         self.far.push(FarPath { slot, hits, swept });
     }
 
+    /// Whether ball `slot`'s path would stay in the grid's cells if it took a new one that
+    /// sweeps `swept` ([`redirect`](Self::redirect) files it there, not in `far`).
+    pub fn keeps_in_cells(&self, grid: &UniformGrid, slot: usize, swept: Circle) -> bool {
+        slot < grid.small_count() && grid.reach_from_cell(slot, swept) <= self.far_limit
+    }
+
     /// Ball `slot` takes no more impacts this step: no path of it is found any more.
     pub fn end(&mut self, grid: &mut UniformGrid, slot: u32) {
         if (slot as usize) < grid.small_count() {
@@ -95,27 +101,63 @@ impl Paths {
         hits_of: impl Fn(u32) -> u32,
         mut visit: impl FnMut(u32),
     ) {
-        let near = DVec2::splat(swept.radius + self.reach);
+        self.for_each_that_may_touch_either(grid, [swept], hits_of, |_, slot| visit(slot));
+    }
+
+    /// [`for_each_that_may_touch`](Self::for_each_that_may_touch) for each of the circles
+    /// `swept` in one pass over the cells around them all: calls `visit(k, slot)` for every
+    /// ball whose current path's circle touches `swept[k]`.
+    pub fn for_each_that_may_touch_either<const N: usize>(
+        &self,
+        grid: &UniformGrid,
+        swept: [Circle; N],
+        hits_of: impl Fn(u32) -> u32,
+        mut visit: impl FnMut(usize, u32),
+    ) {
+        let box_of = |probe: &Circle| {
+            let near = DVec2::splat(probe.radius + self.reach);
+            (probe.center - near, probe.center + near)
+        };
+        let (min, max) = swept.iter().map(box_of).fold(
+            (DVec2::INFINITY, DVec2::NEG_INFINITY),
+            |(min, max), (low, high)| (min.min(low), max.max(high)),
+        );
         let current = grid.circles_by_slot();
-        grid.for_each_cell_run_in_box(swept.center - near, swept.center + near, |cells| {
+        grid.for_each_cell_run_in_box(min, max, |cells| {
             let slots = grid.slots_of(cells);
             let first = slots.start;
             for (offset, &circle) in current[slots].iter().enumerate() {
-                if circles_touch(swept, circle) {
-                    visit((first + offset) as u32);
-                }
+                visit_touching(&swept, (first + offset) as u32, circle, &mut visit);
             }
         });
         // Big balls on their first path, through their own grid; then the paths kept apart.
-        grid.for_each_big_that_may_touch(swept, |slot, circle| {
-            if circles_touch(swept, circle) && hits_of(slot) == 0 {
-                visit(slot);
-            }
-        });
+        for (k, &probe) in swept.iter().enumerate() {
+            grid.for_each_big_that_may_touch(probe, |slot, circle| {
+                if circles_touch(probe, circle) && hits_of(slot) == 0 {
+                    visit(k, slot);
+                }
+            });
+        }
         for path in &self.far {
-            if circles_touch(swept, path.swept) && hits_of(path.slot) == path.hits {
-                visit(path.slot);
+            if hits_of(path.slot) == path.hits {
+                visit_touching(&swept, path.slot, path.swept, &mut visit);
             }
+        }
+    }
+}
+
+/// Calls `visit(k, slot)` for each of the circles `swept[k]` that `circle`, the current path
+/// of the ball in `slot`, touches.
+#[inline]
+fn visit_touching<const N: usize>(
+    swept: &[Circle; N],
+    slot: u32,
+    circle: Circle,
+    visit: &mut impl FnMut(usize, u32),
+) {
+    for (k, &probe) in swept.iter().enumerate() {
+        if circles_touch(probe, circle) {
+            visit(k, slot);
         }
     }
 }

@@ -3,7 +3,8 @@
 //! into the grid; their AABBs and distances cut the candidate pairs, and the exact time of
 //! impact gives each approaching pair's moment of contact within the step, and each ball's
 //! first wall contact. During the timeline, a ball redirected by an impact is predicted for
-//! again against the balls near the rest of its path.
+//! again against the balls near the rest of its path (`repredict.rs`), with the same
+//! pieces: [`pair_time`], the swept circle, the wall's time.
 //!
 //! Two balls with the same acceleration (both in free flight, or both still) close in a
 //! straight line: [`approach_time`]. Otherwise (a falling ball and a still one, or one
@@ -12,7 +13,7 @@
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Party, Prediction, approach_time, swept_circle};
-use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
+use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circles_touch, overlapping};
 use crate::sim::geometry::flight::time_to_touch;
 use crate::sim::geometry::pairs::search_in_bands;
@@ -21,7 +22,7 @@ use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 
 /// Pixels added to a redirected ball's swept circle, so rounding can never make the swept
 /// circles' test reject a pair that touches at the very edge of the step.
-const SWEPT_MARGIN: f64 = 1e-6;
+pub(super) const SWEPT_MARGIN: f64 = 1e-6;
 
 impl Timeline {
     /// The collision stage's part: every impact of the coming step that the balls' current
@@ -133,55 +134,10 @@ impl Timeline {
                 });
         }
     }
-
-    /// Queues the next wall and ball impacts of the ball in `slot`, whose velocity changed
-    /// at `now`.
-    pub(super) fn predict_for(&mut self, slot: usize, now: f64, spec: StepSpec) {
-        let mover = self.movers[slot];
-        if mover.hits == MAX_HITS_PER_BALL {
-            // No more impacts for this ball this step: the end-of-step fallback takes over.
-            self.cut_short = true;
-            self.paths.end(&mut self.grid, slot as u32);
-            return;
-        }
-        let rest = spec.dt - now;
-        let mut swept = swept_by(&mover, rest);
-        swept.radius += SWEPT_MARGIN;
-        let (queue, order) = (&mut self.queue, &self.order);
-        let party = |slot: usize, mover: &Mover| Party::new(slot, order, mover.hits);
-        if let Some((time, wall)) = wall_time(&mover, swept, spec)
-            && now + time <= spec.dt
-        {
-            queue.push(Impact::with_wall(now + time, party(slot, &mover), wall));
-        }
-        self.paths
-            .redirect(&mut self.grid, slot as u32, mover.hits, swept);
-        let movers = &self.movers;
-        let consider = |other: u32| {
-            let other_slot = other as usize;
-            if other_slot == slot {
-                return;
-            }
-            let other_mover = &movers[other_slot];
-            let Some(time) = pair_time(&mover, other_mover, now, spec.dt) else {
-                return;
-            };
-            queue.push(Impact::between(
-                time,
-                party(slot, &mover),
-                party(other_slot, other_mover),
-            ));
-        };
-        // Every ball's current path is known by the circle it sweeps: if two do not touch,
-        // neither can the balls.
-        let hits_of = |other: u32| movers[other as usize].hits;
-        self.paths
-            .for_each_that_may_touch(&self.grid, swept, hits_of, consider);
-    }
 }
 
 /// The circle `mover` sweeps over the next `seconds`.
-fn swept_by(mover: &Mover, seconds: f64) -> Circle {
+pub(super) fn swept_by(mover: &Mover, seconds: f64) -> Circle {
     swept_circle(
         mover.circle(),
         mover.moving_velocity(),
@@ -217,7 +173,7 @@ pub(super) fn pair_time(a: &Mover, b: &Mover, now: f64, end: f64) -> Option<f64>
 /// When a moving `mover` first meets a wall, from its clock on; a still one meets none, and
 /// nor does one whose path, bounded by the circle `swept`, stays clear of every wall by
 /// [`SWEPT_MARGIN`] (its own margin, against rounding).
-fn wall_time(
+pub(super) fn wall_time(
     mover: &Mover,
     swept: Circle,
     spec: StepSpec,

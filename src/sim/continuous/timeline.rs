@@ -142,7 +142,7 @@ impl Timeline {
 
     /// Every ball at the start of the step (placed by [`predict`](Self::predict)), no hits
     /// yet; the predictions queued.
-    fn start(&mut self) {
+    pub(super) fn start(&mut self) {
         self.paths.reset(&self.grid);
         self.queue.start(
             self.predictions
@@ -270,8 +270,7 @@ impl Timeline {
             impulse: exchange.impulse,
             closing_speed: exchange.closing_speed,
         });
-        self.predict_for(a, now, spec);
-        self.predict_for(b, now, spec);
+        self.predict_for_both((a, b), now, spec);
     }
 
     /// Balls `a` and `b` meet slower than the resting speed (`normal` from `a` to `b`): a

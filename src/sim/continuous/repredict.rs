@@ -1,0 +1,197 @@
+//! Stage 3's predictions, continuous: after an impact redirects a ball, its next wall and
+//! ball impacts, found through the grid, where `Paths` keeps every ball's current path. The
+//! two balls of a collision touch, so their neighbourhoods are mostly the same: one search of
+//! the cells around both finds both balls' impacts ([`Timeline::predict_for_both`]).
+
+use super::impact::{Impact, Party};
+use super::predict::{SWEPT_MARGIN, pair_time, swept_by, wall_time};
+use super::queue::ImpactQueue;
+use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
+use crate::sim::geometry::circle::Circle;
+
+impl Timeline {
+    /// Queues the next wall and ball impacts of the ball in `slot`, whose velocity changed
+    /// at `now`.
+    pub(super) fn predict_for(&mut self, slot: usize, now: f64, spec: StepSpec) {
+        if self.movers[slot].hits == MAX_HITS_PER_BALL {
+            // No more impacts for this ball this step: the end-of-step fallback takes over.
+            self.cut_short = true;
+            self.paths.end(&mut self.grid, slot as u32);
+            return;
+        }
+        let swept = self.take_new_path(slot, now, spec);
+        let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
+        let hits_of = |other: u32| movers[other as usize].hits;
+        self.paths
+            .for_each_that_may_touch(&self.grid, swept, hits_of, |other| {
+                queue_pair_impact((movers, order), (slot, other as usize), now, spec.dt, queue);
+            });
+    }
+
+    /// [`predict_for`](Self::predict_for) both balls of an impact between the balls in slots
+    /// `a` and `b` at `now`, in one search of the cells around the two: they touch, so
+    /// their neighbourhoods are mostly the same. It queues what the two calls, `a`'s first,
+    /// would queue, and as the impacts' order does not depend on the order they were found,
+    /// the step is the same to the bit; where the one search could see a different circle
+    /// for `b` than `a`'s own search did (`b` ends or leaves the cells: see `Paths`), it is
+    /// the two calls.
+    pub(super) fn predict_for_both(&mut self, (a, b): (usize, usize), now: f64, spec: StepSpec) {
+        if !self.keeps_in_cells(b, now, spec) || self.movers[a].hits == MAX_HITS_PER_BALL {
+            self.predict_for(a, now, spec);
+            self.predict_for(b, now, spec);
+            return;
+        }
+        let swept_a = self.take_new_path(a, now, spec);
+        let swept_b = self.take_new_path(b, now, spec);
+        let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
+        let hits_of = |other: u32| movers[other as usize].hits;
+        self.paths.for_each_that_may_touch_either(
+            &self.grid,
+            [swept_a, swept_b],
+            hits_of,
+            |which, other| {
+                let slot = if which == 0 { a } else { b };
+                queue_pair_impact((movers, order), (slot, other as usize), now, spec.dt, queue);
+            },
+        );
+    }
+
+    /// Whether the ball in `slot`, redirected at `now`, has hits left and its new path
+    /// stays in the cells (it is no big ball and does not reach too far from its cell).
+    fn keeps_in_cells(&self, slot: usize, now: f64, spec: StepSpec) -> bool {
+        let mover = &self.movers[slot];
+        mover.hits < MAX_HITS_PER_BALL
+            && self
+                .paths
+                .keeps_in_cells(&self.grid, slot, new_swept(mover, now, spec))
+    }
+
+    /// The ball in `slot`, redirected at `now` with hits left, takes its new path: its wall
+    /// impact queued, the path filed (`Paths::redirect`). Returns the circle the path sweeps.
+    fn take_new_path(&mut self, slot: usize, now: f64, spec: StepSpec) -> Circle {
+        let mover = self.movers[slot];
+        let swept = new_swept(&mover, now, spec);
+        if let Some((time, wall)) = wall_time(&mover, swept, spec)
+            && now + time <= spec.dt
+        {
+            let party = Party::new(slot, &self.order, mover.hits);
+            self.queue.push(Impact::with_wall(now + time, party, wall));
+        }
+        self.paths
+            .redirect(&mut self.grid, slot as u32, mover.hits, swept);
+        swept
+    }
+}
+
+/// The circle a ball redirected at `now` sweeps until the step ends, grown by
+/// [`SWEPT_MARGIN`].
+fn new_swept(mover: &Mover, now: f64, spec: StepSpec) -> Circle {
+    let mut swept = swept_by(mover, spec.dt - now);
+    swept.radius += SWEPT_MARGIN;
+    swept
+}
+
+/// Queues the impact of the balls in `slot` and `other`, redirected at `now`, if their paths
+/// meet by `end` (none for a ball with itself).
+fn queue_pair_impact(
+    (movers, order): (&[Mover], &[u32]),
+    (slot, other): (usize, usize),
+    now: f64,
+    end: f64,
+    queue: &mut ImpactQueue,
+) {
+    if other == slot {
+        return;
+    }
+    let (mover, other_mover) = (&movers[slot], &movers[other]);
+    let Some(time) = pair_time(mover, other_mover, now, end) else {
+        return;
+    };
+    let party = |slot: usize, mover: &Mover| Party::new(slot, order, mover.hits);
+    queue.push(Impact::between(
+        time,
+        party(slot, mover),
+        party(other, other_mover),
+    ));
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::DVec2;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::sim::params::MassModel;
+
+    #[test]
+    fn predicting_for_both_balls_of_an_impact_at_once_queues_what_one_at_a_time_does() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let circles: Vec<Circle> = (0..2_000)
+            .map(|_| {
+                let center = DVec2::new(
+                    rng.random_range(-400.0..400.0),
+                    rng.random_range(-400.0..400.0),
+                );
+                Circle::new(center, rng.random_range(3.0..9.0))
+            })
+            .collect();
+        let velocities: Vec<DVec2> = (0..2_000)
+            .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..900.0))
+            .collect();
+        let held = vec![false; 2_000];
+        let spec = StepSpec {
+            dt: 1.0 / 60.0,
+            half: DVec2::splat(410.0),
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+            gravity: DVec2::new(0.0, -400.0),
+            rest_speed: 0.0,
+        };
+        let mut one_at_a_time = Timeline::default();
+        let mut both = Timeline::default();
+        for timeline in [&mut one_at_a_time, &mut both] {
+            timeline.predict(&circles, &velocities, &held, spec);
+            timeline.start();
+        }
+        // Each ball impact taken as a swap of the two velocities; every fifth one's second
+        // ball takes its last hit, which the search for both leaves to one at a time.
+        let (mut redirected, mut taken) = (0, 0);
+        loop {
+            let next = one_at_a_time.queue.pop();
+            assert_eq!(next, both.queue.pop(), "after {taken} impacts");
+            let Some(impact) = next else { break };
+            taken += 1;
+            let (a, b) = (impact.a as usize, impact.other as usize);
+            let current = |timeline: &Timeline| {
+                impact.wall().is_none()
+                    && timeline.movers[a].hits == impact.hits_a
+                    && timeline.movers[b].hits == impact.hits_other
+                    && impact.hits_other < MAX_HITS_PER_BALL
+            };
+            if !current(&both) {
+                continue;
+            }
+            redirected += 1;
+            for timeline in [&mut one_at_a_time, &mut both] {
+                let movers = &mut timeline.movers;
+                movers[a].advance(impact.time);
+                movers[b].advance(impact.time);
+                (movers[a].velocity, movers[b].velocity) = (movers[b].velocity, movers[a].velocity);
+                movers[a].hits += 1;
+                movers[b].hits = if redirected % 5 == 0 {
+                    MAX_HITS_PER_BALL
+                } else {
+                    movers[b].hits + 1
+                };
+            }
+            one_at_a_time.predict_for(a, impact.time, spec);
+            one_at_a_time.predict_for(b, impact.time, spec);
+            both.predict_for_both((a, b), impact.time, spec);
+        }
+        assert!(
+            redirected > 500 && taken > redirected,
+            "{redirected} of {taken}"
+        );
+    }
+}
