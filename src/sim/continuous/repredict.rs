@@ -19,7 +19,8 @@ impl Timeline {
             self.paths.end(&mut self.grid, slot as u32);
             return;
         }
-        let swept = self.take_new_path(slot, now, spec);
+        let swept = new_swept(&self.movers[slot], now, spec);
+        self.take_new_path(slot, swept, now, spec);
         let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
         let hits_of = |other: u32| movers[other as usize].hits;
         self.paths
@@ -36,13 +37,17 @@ impl Timeline {
     /// for `b` than `a`'s own search did (`b` ends or leaves the cells: see `Paths`), it is
     /// the two calls.
     pub(super) fn predict_for_both(&mut self, (a, b): (usize, usize), now: f64, spec: StepSpec) {
-        if !self.keeps_in_cells(b, now, spec) || self.movers[a].hits == MAX_HITS_PER_BALL {
+        let spent = |mover: &Mover| mover.hits == MAX_HITS_PER_BALL;
+        let (mover_a, mover_b) = (&self.movers[a], &self.movers[b]);
+        let swept_b = new_swept(mover_b, now, spec);
+        if spent(mover_a) || spent(mover_b) || !self.paths.keeps_in_cells(&self.grid, b, swept_b) {
             self.predict_for(a, now, spec);
             self.predict_for(b, now, spec);
             return;
         }
-        let swept_a = self.take_new_path(a, now, spec);
-        let swept_b = self.take_new_path(b, now, spec);
+        let swept_a = new_swept(mover_a, now, spec);
+        self.take_new_path(a, swept_a, now, spec);
+        self.take_new_path(b, swept_b, now, spec);
         let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
         let hits_of = |other: u32| movers[other as usize].hits;
         self.paths.for_each_that_may_touch_either(
@@ -56,21 +61,11 @@ impl Timeline {
         );
     }
 
-    /// Whether the ball in `slot`, redirected at `now`, has hits left and its new path
-    /// stays in the cells (it is no big ball and does not reach too far from its cell).
-    fn keeps_in_cells(&self, slot: usize, now: f64, spec: StepSpec) -> bool {
-        let mover = &self.movers[slot];
-        mover.hits < MAX_HITS_PER_BALL
-            && self
-                .paths
-                .keeps_in_cells(&self.grid, slot, new_swept(mover, now, spec))
-    }
-
-    /// The ball in `slot`, redirected at `now` with hits left, takes its new path: its wall
-    /// impact queued, the path filed (`Paths::redirect`). Returns the circle the path sweeps.
-    fn take_new_path(&mut self, slot: usize, now: f64, spec: StepSpec) -> Circle {
+    /// The ball in `slot`, redirected at `now` with hits left, takes its new path, which
+    /// sweeps `swept` ([`new_swept`]): its wall impact queued, the path filed
+    /// (`Paths::redirect`).
+    fn take_new_path(&mut self, slot: usize, swept: Circle, now: f64, spec: StepSpec) {
         let mover = self.movers[slot];
-        let swept = new_swept(&mover, now, spec);
         if let Some((time, wall)) = wall_time(&mover, swept, spec)
             && now + time <= spec.dt
         {
@@ -79,7 +74,6 @@ impl Timeline {
         }
         self.paths
             .redirect(&mut self.grid, slot as u32, mover.hits, swept);
-        swept
     }
 }
 
