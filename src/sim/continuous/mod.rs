@@ -31,6 +31,7 @@ mod bands;
 pub mod impact;
 mod paths;
 pub mod predict;
+mod prefetch;
 mod queue;
 mod repredict;
 pub mod state;

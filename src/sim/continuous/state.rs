@@ -161,6 +161,9 @@ pub struct Timeline {
     /// Whether the last run handled some impact after one that comes later in the impacts'
     /// order (see `Impact`'s `Ord`): then its hits are not in that order.
     pub(super) out_of_order: bool,
+    /// Whether every ball the last run moved to the end of the step lay inside the walls
+    /// then (`lies_inside`), so that only the balls moved since may need containing.
+    pub(super) ends_inside: bool,
     /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
     pub cut_short: bool,
     /// The walls' impulse on balls that stopped against them by the resting rule in the last

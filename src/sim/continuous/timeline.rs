@@ -13,8 +13,6 @@
 //! ball that holds still holds still itself until the step ends; two flying balls meeting
 //! that slowly move on together (restitution 0). None of these is a hit.
 
-use std::hint::black_box;
-
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Prediction};
@@ -22,20 +20,10 @@ use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
 use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
 use crate::sim::geometry::pairs::find_contacts;
-use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_all};
+use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_all, lies_inside};
 use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 use crate::sim::params::BroadPhase;
 use crate::sim::report::{Hit, record_walls_met};
-
-/// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
-/// cells around a ball (and twice as many ahead, the balls themselves): 2 and 8 did as well
-/// at a million balls.
-const PREFETCH_DISTANCE: usize = 4;
-
-/// Below this many balls the timeline's arrays (about 130 B a ball) mostly fit the cache, and
-/// [`Timeline::prefetch_coming`] only costs: 1–2% at 1,000 and 10,000 balls, where from
-/// 30,000 on it gains (README, *Prefetching the coming impacts*).
-const PREFETCH_MIN_BALLS: usize = 20_000;
 
 impl Timeline {
     /// The response stage's part: handles the predicted impacts in time order, predicting
@@ -57,7 +45,10 @@ impl Timeline {
             self.resolve_what_was_cut_short(circles, velocities, held, spec, &mut on_hit);
         }
         self.push_apart_overlaps(circles, held, spec);
-        self.resting_wall_impulse += contain_at_the_end(circles, velocities, spec, &mut on_hit);
+        // Every ball inside, and none moved since: the walls have nothing to do.
+        if !self.ends_inside || self.cut_short || !self.overlapping.is_empty() {
+            self.resting_wall_impulse += contain_at_the_end(circles, velocities, spec, &mut on_hit);
+        }
     }
 
     /// The impacts in time order, then every ball to the end of the step: [`run`](Self::run)
@@ -72,7 +63,7 @@ impl Timeline {
     ) {
         self.start();
         let mut last = None;
-        let prefetching = self.movers.len() >= PREFETCH_MIN_BALLS;
+        let prefetching = self.worth_prefetching();
         while let Some(impact) = self.queue.pop() {
             if prefetching {
                 self.prefetch_coming();
@@ -92,52 +83,23 @@ impl Timeline {
         self.move_to_the_end(circles, velocities, (held, stopped), spec);
     }
 
-    /// Loads what the impacts about to be taken will read, so that it is in the cache when
-    /// they are: impacts come in time order, so each one's balls lie anywhere in memory, and
-    /// at a million balls waiting for those reads is most of an impact's cost (README,
-    /// *Prefetching the coming impacts*). For the step's first predictions a few places
-    /// ahead, the balls first and, nearer, the cells around the first ball (which need its
-    /// cell, loaded with the balls); for the earliest impact predicted since, all at once.
-    /// Nothing here changes a result.
-    fn prefetch_coming(&self) {
-        if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
-            self.prefetch_balls(further);
-        }
-        if let Some(nearer) = self.queue.ahead(PREFETCH_DISTANCE) {
-            self.grid.prefetch_cells_around(nearer.a as usize);
-        }
-        if let Some(&later) = self.queue.earliest_later() {
-            self.prefetch_balls(later);
-            self.grid.prefetch_cells_around(later.a as usize);
-        }
-    }
-
-    /// Loads the movers of `impact`'s balls and the first one's slot in the grid.
-    fn prefetch_balls(&self, impact: Impact) {
-        // A mover spans two cache lines: its first field and its last but one load both
-        // (its layout is fixed: `repr(C)`).
-        let load =
-            |slot: u32| black_box(self.movers.get(slot as usize).map(|m| (m.center, m.hits)));
-        load(impact.a);
-        if impact.wall().is_none() {
-            load(impact.other);
-        }
-        self.grid.prefetch_slot(impact.a as usize);
-    }
-
     /// The end of a step whose impacts ran in bands that held ([`Bands`](super::bands::Bands)):
     /// no band's balls overlapped at the start or were cut short, so only the walls are left,
-    /// as [`run`](Self::run) ends.
+    /// as [`run`](Self::run) ends; none of them if every band's balls `ends_inside`.
     pub(super) fn finish_after_bands(
         &mut self,
-        circles: &mut [Circle],
-        velocities: &mut [DVec2],
+        (circles, velocities): (&mut [Circle], &mut [DVec2]),
+        ends_inside: bool,
         spec: StepSpec,
         mut on_hit: impl FnMut(Hit),
     ) {
         self.overlapping.clear();
         self.cut_short = false;
-        self.resting_wall_impulse = contain_at_the_end(circles, velocities, spec, &mut on_hit);
+        self.resting_wall_impulse = if ends_inside {
+            0.0
+        } else {
+            contain_at_the_end(circles, velocities, spec, &mut on_hit)
+        };
     }
 
     /// Every ball at the start of the step (placed by [`predict`](Self::predict)), no hits
@@ -344,12 +306,15 @@ impl Timeline {
                 movers.iter_mut().for_each(|mover| mover.advance(spec.dt));
             },
         );
+        let mut inside = true;
         for (&ball, mover) in self.order.iter().zip(&self.movers) {
             let index = ball as usize;
             (circles[index].center, velocities[index]) = (mover.center, mover.velocity);
             held[index] &= mover.still && mover.hits == 0;
             stopped[index] = mover.still && !held[index];
+            inside &= lies_inside(mover.center, mover.radius, spec.half);
         }
+        self.ends_inside = inside;
     }
 
     /// Some balls stopped taking hits: whatever overlaps now gets the discrete response.

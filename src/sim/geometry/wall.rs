@@ -84,6 +84,17 @@ pub fn contain_in_arena(
     contain_at_rest(position, velocity, radius, half, restitution, 0.0)
 }
 
+/// Whether [`contain_at_rest`] leaves a ball at `position` of `radius` where it is, whatever
+/// its velocity: it lies wholly within the arena `[-half, half]` (a NaN does not), so no
+/// wall has anything to do with it.
+pub fn lies_inside(position: DVec2, radius: f64, half: DVec2) -> bool {
+    // The same sums as `contain_at_rest`'s: the limit, and the overshoot on either side.
+    let limit = half - DVec2::splat(radius);
+    let above = limit.cmpgt(DVec2::ZERO);
+    let within = (position - limit).cmple(DVec2::ZERO) & (-position - limit).cmple(DVec2::ZERO);
+    (above & within).all()
+}
+
 /// [`contain_in_arena`] with the resting rule: a ball meeting a wall slower than
 /// `rest_speed` (pixels per second) does not bounce but stops against it (restitution 0,
 /// and its [`WallHit`] says `resting`).
@@ -280,6 +291,45 @@ mod tests {
     use super::*;
 
     const HALF: DVec2 = DVec2::new(100.0, 50.0);
+
+    #[test]
+    fn a_ball_that_lies_inside_is_one_the_walls_leave_as_it_is() {
+        // Centres on a lattice across the walls and past them, a hair from each limit, radii
+        // up to wider than the arena, a NaN; velocities into each wall and out of it.
+        let hair = 1e-12;
+        // The limits for a radius of 10 are 90 (x) and 40 (y).
+        let across = |limit: f64| {
+            let near = [limit - hair, limit, limit + hair];
+            [-1.4 * limit, 0.0, 0.4 * limit, 1.3 * limit, f64::NAN]
+                .into_iter()
+                .chain(near.into_iter().flat_map(|x| [x, -x]))
+        };
+        let (mut inside, mut contained) = (0, 0);
+        for x in across(90.0) {
+            for y in across(40.0) {
+                for radius in [10.0, 60.0, 150.0] {
+                    for velocity in [DVec2::new(30.0, -20.0), DVec2::new(-30.0, 20.0)] {
+                        let position = DVec2::new(x, y);
+                        let c = contain_at_rest(position, velocity, radius, HALF, 0.8, 5.0);
+                        let left_alone = c.position.to_array().map(f64::to_bits)
+                            == position.to_array().map(f64::to_bits)
+                            && c.velocity == velocity
+                            && c.hits == [None, None];
+                        if lies_inside(position, radius, HALF) {
+                            assert!(left_alone, "{position} r {radius}: {c:?}");
+                            inside += 1;
+                        } else {
+                            contained += usize::from(!left_alone);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            inside > 40 && contained > 200,
+            "{inside} inside, {contained} contained"
+        );
+    }
 
     #[test]
     fn ball_past_the_right_wall_is_mirrored_back_and_reflected() {

@@ -138,7 +138,9 @@ impl Bands {
                 keep_ball_hits,
                 &mut on_hit,
             ) {
-                timeline.finish_after_bands(circles, velocities, spec, on_hit);
+                let ends_inside = self.bands.iter().all(|band| band.timeline.ends_inside);
+                let balls = (&mut *circles, &mut *velocities);
+                timeline.finish_after_bands(balls, ends_inside, spec, on_hit);
                 return counted;
             }
             // The bands did not hold: the step as one timeline.
