@@ -13,8 +13,7 @@
 //!   ([`impact`] holds what a prediction is);
 //! - stage 3, [`run_timeline`] ([`timeline`]): the impacts in time order, predicting anew for
 //!   the balls each one redirects (`repredict.rs`; `paths.rs` keeps every ball's current path
-//!   by slot), then
-//!   every ball to the end of the step, and the balls written back.
+//!   by slot), then every ball to the end of the step, and the balls written back.
 //!
 //! From 20,000 to 400,000 balls with more than one thread, both stages take the step in
 //! horizontal bands of the arena, one timeline each, at once (`bands/`): the balls near each

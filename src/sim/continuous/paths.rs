@@ -79,12 +79,6 @@ impl Paths {
         self.far.push(FarPath { slot, hits, swept });
     }
 
-    /// Whether ball `slot`'s path would stay in the grid's cells if it took a new one that
-    /// sweeps `swept` ([`redirect`](Self::redirect) files it there, not in `far`).
-    pub fn keeps_in_cells(&self, grid: &UniformGrid, slot: usize, swept: Circle) -> bool {
-        slot < grid.small_count() && grid.reach_from_cell(slot, swept) <= self.far_limit
-    }
-
     /// Ball `slot` takes no more impacts this step: no path of it is found any more.
     pub fn end(&mut self, grid: &mut UniformGrid, slot: u32) {
         if (slot as usize) < grid.small_count() {
@@ -101,13 +95,13 @@ impl Paths {
         hits_of: impl Fn(u32) -> u32,
         mut visit: impl FnMut(u32),
     ) {
-        self.for_each_that_may_touch_either(grid, [swept], hits_of, |_, slot| visit(slot));
+        self.for_each_that_may_touch_any(grid, [swept], hits_of, |_, slot| visit(slot));
     }
 
     /// [`for_each_that_may_touch`](Self::for_each_that_may_touch) for each of the circles
     /// `swept` in one pass over the cells around them all: calls `visit(k, slot)` for every
     /// ball whose current path's circle touches `swept[k]`.
-    pub fn for_each_that_may_touch_either<const N: usize>(
+    pub fn for_each_that_may_touch_any<const N: usize>(
         &self,
         grid: &UniformGrid,
         swept: [Circle; N],

@@ -7,7 +7,7 @@ use super::impact::{Impact, Party};
 use super::predict::{SWEPT_MARGIN, pair_time, swept_by, wall_time};
 use super::queue::ImpactQueue;
 use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
-use crate::sim::geometry::circle::Circle;
+use crate::sim::geometry::circle::{Circle, circles_touch};
 
 impl Timeline {
     /// Queues the next wall and ball impacts of the ball in `slot`, whose velocity changed
@@ -33,32 +33,37 @@ impl Timeline {
     /// `a` and `b` at `now`, in one search of the cells around the two: they touch, so
     /// their neighbourhoods are mostly the same. It queues what the two calls, `a`'s first,
     /// would queue, and as the impacts' order does not depend on the order they were found,
-    /// the step is the same to the bit; where the one search could see a different circle
-    /// for `b` than `a`'s own search did (`b` ends or leaves the cells: see `Paths`), it is
-    /// the two calls.
+    /// the step is the same to the bit. The one thing the two calls' searches saw differently
+    /// is `b` in `a`'s search, made before `b` took its new path: so the pair is left out of
+    /// the one search and timed apart if `a`'s own search would have found `b`'s path until
+    /// now. (A ball that has taken its last hit takes the two calls.)
     pub(super) fn predict_for_both(&mut self, (a, b): (usize, usize), now: f64, spec: StepSpec) {
-        let spent = |mover: &Mover| mover.hits == MAX_HITS_PER_BALL;
-        let (mover_a, mover_b) = (&self.movers[a], &self.movers[b]);
-        let swept_b = new_swept(mover_b, now, spec);
-        if spent(mover_a) || spent(mover_b) || !self.paths.keeps_in_cells(&self.grid, b, swept_b) {
+        let spent = |slot: usize| self.movers[slot].hits == MAX_HITS_PER_BALL;
+        if spent(a) || spent(b) {
             self.predict_for(a, now, spec);
             self.predict_for(b, now, spec);
             return;
         }
-        let swept_a = new_swept(mover_a, now, spec);
-        self.take_new_path(a, swept_a, now, spec);
-        self.take_new_path(b, swept_b, now, spec);
+        let swept = [a, b].map(|slot| new_swept(&self.movers[slot], now, spec));
+        self.take_new_path(a, swept[0], now, spec);
+        // `b`'s path until now is found in its cell (one kept apart, or a big ball's, is
+        // stale by its hits since this impact).
+        let a_finds_b =
+            b < self.grid.small_count() && circles_touch(swept[0], self.grid.circle_in_slot(b));
+        self.take_new_path(b, swept[1], now, spec);
         let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
         let hits_of = |other: u32| movers[other as usize].hits;
-        self.paths.for_each_that_may_touch_either(
-            &self.grid,
-            [swept_a, swept_b],
-            hits_of,
-            |which, other| {
-                let slot = if which == 0 { a } else { b };
-                queue_pair_impact((movers, order), (slot, other as usize), now, spec.dt, queue);
-            },
-        );
+        let (end, balls) = (spec.dt, (movers.as_slice(), order.as_slice()));
+        self.paths
+            .for_each_that_may_touch_any(&self.grid, swept, hits_of, |k, other| {
+                let (slot, other) = ([a, b][k], other as usize);
+                if (slot, other) != (a, b) {
+                    queue_pair_impact(balls, (slot, other), now, end, queue);
+                }
+            });
+        if a_finds_b {
+            queue_pair_impact(balls, (a, b), now, end, queue);
+        }
     }
 
     /// The ball in `slot`, redirected at `now` with hits left, takes its new path, which
@@ -121,18 +126,31 @@ mod tests {
     #[test]
     fn predicting_for_both_balls_of_an_impact_at_once_queues_what_one_at_a_time_does() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let circles: Vec<Circle> = (0..2_000)
-            .map(|_| {
+        // Balls of radius 3-9 and, one in a hundred, 40 (big: kept apart in the grid); one in
+        // twenty ten times as fast, whose paths reach too far for the cells (kept apart too).
+        let circles: Vec<Circle> = (0..2_000_usize)
+            .map(|k| {
                 let center = DVec2::new(
                     rng.random_range(-400.0..400.0),
                     rng.random_range(-400.0..400.0),
                 );
-                Circle::new(center, rng.random_range(3.0..9.0))
+                let big = k.is_multiple_of(100);
+                Circle::new(
+                    center,
+                    if big {
+                        40.0
+                    } else {
+                        rng.random_range(3.0..9.0)
+                    },
+                )
             })
             .collect();
-        let velocities: Vec<DVec2> = (0..2_000)
-            .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..900.0))
-            .collect();
+        let mut velocity = |k: usize| {
+            let speed =
+                rng.random_range(0.0..900.0) * if k.is_multiple_of(20) { 10.0 } else { 1.0 };
+            DVec2::from_angle(rng.random_range(0.0..6.3)) * speed
+        };
+        let velocities: Vec<DVec2> = (0..2_000).map(&mut velocity).collect();
         let held = vec![false; 2_000];
         let spec = StepSpec {
             dt: 1.0 / 60.0,
@@ -148,9 +166,11 @@ mod tests {
             timeline.predict(&circles, &velocities, &held, spec);
             timeline.start();
         }
-        // Each ball impact taken as a swap of the two velocities; every fifth one's second
-        // ball takes its last hit, which the search for both leaves to one at a time.
-        let (mut redirected, mut taken) = (0, 0);
+        // Each ball impact gives its balls new velocities, at random (so that they may still
+        // approach); every fifth one's second ball takes its last hit, which the search for
+        // both leaves to one at a time.
+        let (mut redirected, mut taken) = (0_u32, 0);
+        let (mut with_big, mut kept_apart) = (0, 0);
         loop {
             let next = one_at_a_time.queue.pop();
             assert_eq!(next, both.queue.pop(), "after {taken} impacts");
@@ -167,13 +187,16 @@ mod tests {
                 continue;
             }
             redirected += 1;
+            with_big += usize::from(b >= both.grid.small_count());
+            kept_apart += usize::from(both.paths.keeps_some_apart());
+            let new = [velocity(a), velocity(b)];
             for timeline in [&mut one_at_a_time, &mut both] {
                 let movers = &mut timeline.movers;
                 movers[a].advance(impact.time);
                 movers[b].advance(impact.time);
-                (movers[a].velocity, movers[b].velocity) = (movers[b].velocity, movers[a].velocity);
+                (movers[a].velocity, movers[b].velocity) = (new[0], new[1]);
                 movers[a].hits += 1;
-                movers[b].hits = if redirected % 5 == 0 {
+                movers[b].hits = if redirected.is_multiple_of(5) {
                     MAX_HITS_PER_BALL
                 } else {
                     movers[b].hits + 1
@@ -184,8 +207,8 @@ mod tests {
             both.predict_for_both((a, b), impact.time, spec);
         }
         assert!(
-            redirected > 500 && taken > redirected,
-            "{redirected} of {taken}"
+            redirected > 500 && taken > redirected && with_big > 5 && kept_apart > 100,
+            "{redirected} of {taken}, {with_big} with a big ball, {kept_apart} with paths apart"
         );
     }
 }

@@ -1,7 +1,8 @@
 //! The continuous mode's working state: the [`Timeline`] resource, every ball on it as a
 //! `Mover`, and what a step needs of the parameters ([`StepSpec`]). `predict.rs` (stage 2)
-//! and `timeline.rs` (stage 3) each implement their half of `Timeline` on it; here are what
-//! the bands (`bands/`) ask of a run: its hits by ball, how far its paths reached.
+//! and `timeline.rs` (stage 3, with `repredict.rs` and `prefetch.rs`) each implement their
+//! half of `Timeline` on it; here are what the bands (`bands/`) ask of a run: its hits by
+//! ball, how far its paths reached.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
