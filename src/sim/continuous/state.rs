@@ -121,11 +121,19 @@ impl Mover {
         velocity_after(self.moving_velocity(), self.accel, time - self.clock)
     }
 
-    pub fn advance(&mut self, time: f64) {
-        if !self.still {
-            self.center = self.center_at(time);
-            self.velocity = self.velocity_at(time);
+    /// Where it is and how fast it moves `time` seconds into the step (a still ball's
+    /// velocity is the one it will have at the end of the step).
+    #[inline]
+    pub fn state_at(&self, time: f64) -> (DVec2, DVec2) {
+        if self.still {
+            (self.center, self.velocity)
+        } else {
+            (self.center_at(time), self.velocity_at(time))
         }
+    }
+
+    pub fn advance(&mut self, time: f64) {
+        (self.center, self.velocity) = self.state_at(time);
         self.clock = time;
     }
 

@@ -298,21 +298,26 @@ impl Timeline {
         (held, stopped): (&mut [bool], &mut [bool]),
         spec: StepSpec,
     ) {
+        // On more than one thread the movers move in pieces at once, then are written; on one,
+        // each is moved as it is written, in one pass.
         let parallel = worth_splitting(self.movers.len());
-        in_pieces(
-            self.movers.chunks_mut(BALLS_PER_PIECE),
-            parallel,
-            |movers| {
+        if parallel {
+            in_pieces(self.movers.chunks_mut(BALLS_PER_PIECE), true, |movers| {
                 movers.iter_mut().for_each(|mover| mover.advance(spec.dt));
-            },
-        );
+            });
+        }
         let mut inside = true;
         for (&ball, mover) in self.order.iter().zip(&self.movers) {
             let index = ball as usize;
-            (circles[index].center, velocities[index]) = (mover.center, mover.velocity);
+            let (center, velocity) = if parallel {
+                (mover.center, mover.velocity)
+            } else {
+                mover.state_at(spec.dt)
+            };
+            (circles[index].center, velocities[index]) = (center, velocity);
             held[index] &= mover.still && mover.hits == 0;
             stopped[index] = mover.still && !held[index];
-            inside &= lies_inside(mover.center, mover.radius, spec.half);
+            inside &= lies_inside(center, mover.radius, spec.half);
         }
         self.ends_inside = inside;
     }
