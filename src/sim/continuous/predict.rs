@@ -4,7 +4,7 @@
 //! impact gives each approaching pair's moment of contact within the step, and each ball's
 //! first wall contact. During the timeline, a ball redirected by an impact is predicted for
 //! again against the balls near the rest of its path (`repredict.rs`), with the same
-//! pieces: [`pair_time`], the swept circle, the wall's time.
+//! pieces: `pair_time`, the swept circle, the wall's time.
 //!
 //! Two balls with the same acceleration (both in free flight, or both still) close in a
 //! straight line: [`approach_time`]. Otherwise (a falling ball and a still one, or one
@@ -220,7 +220,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::sim::params::MassModel;
 
     /// The predictions in a fixed order, for comparing two searches.
     fn sorted(predictions: &[Prediction]) -> Vec<String> {
@@ -251,12 +250,9 @@ mod tests {
             })
             .collect();
         let spec = StepSpec {
-            dt: 1.0 / 60.0,
-            half: DVec2::splat(320.0),
             restitution: 0.5,
-            mass_model: MassModel::Radius,
-            gravity: DVec2::new(0.0, -500.0),
             rest_speed: 16.7,
+            ..StepSpec::sixtieth(DVec2::splat(320.0), DVec2::new(0.0, -500.0))
         };
         let mut timeline = Timeline::default();
         timeline.predict(&circles, &velocities, &held, spec);
@@ -278,14 +274,7 @@ mod tests {
     #[test]
     fn skipping_the_walls_out_of_reach_finds_every_wall_impact_the_full_search_finds() {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
-        let spec = StepSpec {
-            dt: 1.0 / 60.0,
-            half: DVec2::new(200.0, 150.0),
-            restitution: 1.0,
-            mass_model: MassModel::Radius,
-            gravity: DVec2::new(0.0, -900.0),
-            rest_speed: 0.0,
-        };
+        let spec = StepSpec::sixtieth(DVec2::new(200.0, 150.0), DVec2::new(0.0, -900.0));
         let mut reached = 0;
         for case in 0..4000 {
             let radius = rng.random_range(2.0..20.0);

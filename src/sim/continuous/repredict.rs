@@ -121,7 +121,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::sim::params::MassModel;
 
     #[test]
     fn predicting_for_both_balls_of_an_impact_at_once_queues_what_one_at_a_time_does() {
@@ -152,14 +151,7 @@ mod tests {
         };
         let velocities: Vec<DVec2> = (0..2_000).map(&mut velocity).collect();
         let held = vec![false; 2_000];
-        let spec = StepSpec {
-            dt: 1.0 / 60.0,
-            half: DVec2::splat(410.0),
-            restitution: 1.0,
-            mass_model: MassModel::Radius,
-            gravity: DVec2::new(0.0, -400.0),
-            rest_speed: 0.0,
-        };
+        let spec = StepSpec::sixtieth(DVec2::splat(410.0), DVec2::new(0.0, -400.0));
         let mut one_at_a_time = Timeline::default();
         let mut both = Timeline::default();
         for timeline in [&mut one_at_a_time, &mut both] {

@@ -54,6 +54,22 @@ impl StepSpec {
     }
 }
 
+#[cfg(test)]
+impl StepSpec {
+    /// Tests' step: 1/60 s in the arena `[-half, half]`, elastic, mass = radius, under
+    /// `gravity`, no resting rule.
+    pub fn sixtieth(half: DVec2, gravity: DVec2) -> Self {
+        Self {
+            dt: 1.0 / 60.0,
+            half,
+            restitution: 1.0,
+            mass_model: MassModel::Radius,
+            gravity,
+            rest_speed: 0.0,
+        }
+    }
+}
+
 /// A ball on the step's timeline: where it is `clock` seconds into the step, and how many hits
 /// it has taken.
 ///

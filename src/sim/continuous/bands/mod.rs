@@ -332,7 +332,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::sim::params::MassModel;
 
     /// `count` balls of radius 5–15 px, about 30% of a square arena, stored row by row as a
     /// scene spawns them, at up to 500 px/s: the standard gas.
@@ -352,14 +351,7 @@ mod tests {
         let velocities = (0..count)
             .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..500.0))
             .collect();
-        let spec = StepSpec {
-            dt: 1.0 / 60.0,
-            half: DVec2::splat(side / 2.0),
-            restitution: 1.0,
-            mass_model: MassModel::Radius,
-            gravity: DVec2::ZERO,
-            rest_speed: 0.0,
-        };
+        let spec = StepSpec::sixtieth(DVec2::splat(side / 2.0), DVec2::ZERO);
         (circles, velocities, spec)
     }
 
@@ -427,14 +419,7 @@ mod tests {
         ];
         let fling = DVec2::new(-600.0, 0.0);
         let mut velocities = [DVec2::ZERO, DVec2::ZERO, fling];
-        let spec = StepSpec {
-            dt: 1.0 / 60.0,
-            half: DVec2::splat(500.0),
-            restitution: 1.0,
-            mass_model: MassModel::Radius,
-            gravity: DVec2::ZERO,
-            rest_speed: 0.0,
-        };
+        let spec = StepSpec::sixtieth(DVec2::splat(500.0), DVec2::ZERO);
         let (mut held, mut stopped) = ([false; 3], [false; 3]);
         let mut timeline = Timeline::default();
         timeline.predict(&circles, &velocities, &held, spec);
