@@ -25,7 +25,7 @@ use bevy::prelude::*;
 use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, SnapshotBalls};
 use super::clock::SimClock;
 use super::geometry::Circle;
-use super::geometry::wall::{Contained, contain_piece};
+use super::geometry::contain::{Contained, contain_piece};
 use super::params::{MassModel, SimParams};
 use super::report::{StepLog, record_walls_met};
 use super::resting::rest_speed;

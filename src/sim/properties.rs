@@ -12,8 +12,9 @@ use super::continuous::{StepSpec, Timeline};
 use super::geometry::circle::{
     Circle, circle_contact, circles_touch, collision_point, time_of_impact,
 };
+use super::geometry::contain::contain_in_arena;
 use super::geometry::impulse::{normal_exchange, resolve_overlaps};
-use super::geometry::wall::{contain_in_arena, wall_time_of_impact};
+use super::geometry::wall::wall_time_of_impact;
 use super::params::{MAX_SPEED, MassModel, RADIUS_RANGE};
 
 /// Relative tolerance for one hit.

@@ -148,6 +148,7 @@ impl Mover {
         }
     }
 
+    /// Moves it to `time` seconds into the step ([`state_at`](Self::state_at)).
     pub fn advance(&mut self, time: f64) {
         (self.center, self.velocity) = self.state_at(time);
         self.clock = time;
@@ -178,7 +179,8 @@ pub struct Timeline {
     /// The pairs that overlapped at the start of the step, by input index, lower first.
     pub(super) overlapping: Vec<(u32, u32)>,
     /// Every ball on this step's timeline, by slot: all a prediction reads of one ball in
-    /// one place (72 B, two cache lines).
+    /// one place (72 B, two cache lines). After a run they are not necessarily moved to the
+    /// end of the step (only when that was split between threads): the step's arrays are.
     pub(super) movers: Vec<Mover>,
     pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.

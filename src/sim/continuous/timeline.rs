@@ -18,9 +18,10 @@ use bevy::math::DVec2;
 use super::impact::{Impact, Prediction};
 use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
+use crate::sim::geometry::contain::{contain_all, lies_inside};
 use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
 use crate::sim::geometry::pairs::find_contacts;
-use crate::sim::geometry::wall::{Wall, bounce_off_wall, contain_all, lies_inside};
+use crate::sim::geometry::wall::{Wall, bounce_off_wall};
 use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
 use crate::sim::params::BroadPhase;
 use crate::sim::report::{Hit, record_walls_met};
@@ -85,7 +86,7 @@ impl Timeline {
 
     /// The end of a step whose impacts ran in bands that held ([`Bands`](super::bands::Bands)):
     /// no band's balls overlapped at the start or were cut short, so only the walls are left,
-    /// as [`run`](Self::run) ends; none of them if every band's balls `ends_inside`.
+    /// as [`run`](Self::run) ends, and not even the walls if every band's balls ended inside.
     pub(super) fn finish_after_bands(
         &mut self,
         (circles, velocities): (&mut [Circle], &mut [DVec2]),
