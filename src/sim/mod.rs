@@ -36,6 +36,7 @@
 
 pub mod aim;
 pub mod ball;
+pub mod cache;
 pub mod carry;
 pub mod clock;
 pub mod continuous;

@@ -4,10 +4,9 @@
 //! cost (README, *Prefetching the coming impacts*). The timeline's loop calls
 //! [`Timeline::prefetch_coming`] before each impact; nothing here changes a result.
 
-use std::hint::black_box;
-
 use super::impact::Impact;
 use super::state::Timeline;
+use crate::sim::cache::prefetch;
 
 /// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
 /// cells around a ball (and twice as many ahead, the balls themselves): 2 and 8 did as well
@@ -47,10 +46,13 @@ impl Timeline {
 
     /// Loads the movers of `impact`'s balls and the first one's slot in the grid.
     fn prefetch_balls(&self, impact: Impact) {
-        // A mover spans two cache lines: its first field and its last but one load both
+        // A mover spans two cache lines: its first field and its last but one bring both
         // (its layout is fixed: `repr(C)`).
-        let load =
-            |slot: u32| black_box(self.movers.get(slot as usize).map(|m| (m.center, m.hits)));
+        let load = |slot: u32| {
+            let mover = self.movers.get(slot as usize);
+            prefetch(mover.map(|mover| &mover.center));
+            prefetch(mover.map(|mover| &mover.hits));
+        };
         load(impact.a);
         if impact.wall().is_none() {
             load(impact.other);

@@ -4,13 +4,13 @@
 //! and the big balls' part for each ball an impact redirects. Last, the loads that bring a
 //! ball's place into the cache ahead of such a query.
 
-use std::hint::black_box;
 use std::ops::Range;
 
 use bevy::math::DVec2;
 
 use super::counting::NO_CELL;
 use super::uniform::UniformGrid;
+use crate::sim::cache::prefetch;
 use crate::sim::geometry::circle::Circle;
 
 impl UniformGrid {
@@ -51,26 +51,22 @@ impl UniformGrid {
         self.for_each_that_may_touch(circle, visit);
     }
 
-    /// Loads what a query around the ball in `slot` reads first, its cell and circle, so
-    /// that they are in the cache when the query comes (after
-    /// [`renumber_by_slot`](Self::renumber_by_slot)). Safe Rust has no prefetch instruction,
-    /// so this is a plain load whose value goes to [`black_box`], which keeps the optimiser
-    /// from dropping it: the processor starts it at once and goes on with the instructions
-    /// that follow (a few hundred, its reorder window) while the miss is served, so misses
-    /// overlap with work instead of being waited for one at a time.
+    /// Brings what a query around the ball in `slot` reads first, its cell and circle, into
+    /// the cache ([`prefetch`]) before the query comes (after
+    /// [`renumber_by_slot`](Self::renumber_by_slot)).
     pub fn prefetch_slot(&self, slot: usize) {
-        black_box(self.cell_of.get(slot).copied());
-        black_box(self.sorted_circle.get(slot).copied());
+        prefetch(self.cell_of.get(slot));
+        prefetch(self.sorted_circle.get(slot));
     }
 
-    /// Loads the first circle of each row of cells around the ball in `slot` (its cell's row
-    /// and the rows beside it, three cells wide), as [`prefetch_slot`](Self::prefetch_slot)
-    /// does: where a query around the ball will read. Best some time after `prefetch_slot`,
-    /// which loads the ball's cell, read here.
+    /// Brings the first circle of each row of cells around the ball in `slot` (its cell's
+    /// row and the rows beside it, three cells wide) into the cache, as
+    /// [`prefetch_slot`](Self::prefetch_slot) does: where a query around the ball will read.
+    /// Best some time after `prefetch_slot`, which brings the ball's cell, read here.
     pub fn prefetch_cells_around(&self, slot: usize) {
         for cells in self.cell_runs_around(slot) {
             let first_slot = self.cell_start.get(cells.start).map(|&slot| slot as usize);
-            black_box(first_slot.and_then(|slot| self.sorted_circle.get(slot).copied()));
+            prefetch(first_slot.and_then(|slot| self.sorted_circle.get(slot)));
         }
     }
 
