@@ -1,6 +1,8 @@
 //! The timeline's queue of impacts, earliest first. Most of a step's impacts are predicted
-//! at its start: those are sorted once and read in order, and only the ones predicted during
-//! the step (after an impact redirects a ball) go into a heap, which stays small. Taking the
+//! at its start: those are sorted once and read in order. The ones predicted during the step
+//! (after an impact redirects a ball) fall into buckets by time, as in a calendar queue: only
+//! the earliest bucket's impacts are in a heap, which stays small enough for the cache however
+//! many balls there are, and each of the others is a plain list until its turn. Taking the
 //! earlier of the two heads gives the order one heap of them all would give.
 
 use std::cmp::Reverse;
@@ -14,25 +16,26 @@ pub struct ImpactQueue {
     /// The impacts predicted at the start of the step, in order; `sorted[next..]` are left.
     sorted: Vec<Impact>,
     next: usize,
-    /// The impacts predicted since.
-    later: BinaryHeap<Reverse<Impact>>,
+    /// The impacts predicted since, by bucket of time.
+    later: Buckets,
 }
 
 impl ImpactQueue {
-    /// Empties the queue and fills it with the step's first predictions.
-    pub fn start(&mut self, impacts: impl Iterator<Item = Impact> + Clone) {
+    /// Empties the queue and fills it with the step's first predictions; those predicted
+    /// during the step will mostly lie within `horizon` seconds of its start.
+    pub fn start(&mut self, impacts: impl Iterator<Item = Impact> + Clone, horizon: f64) {
         self.sorted.clear();
         // Exactly what is needed: the buffer is kept from step to step.
         self.sorted.reserve_exact(impacts.clone().count());
         self.sorted.extend(impacts);
         self.sorted.sort_unstable();
         self.next = 0;
-        self.later.clear();
+        self.later.start(horizon, self.sorted.len());
     }
 
     /// Adds an impact predicted during the step.
     pub fn push(&mut self, impact: Impact) {
-        self.later.push(Reverse(impact));
+        self.later.push(impact);
     }
 
     /// The step's first prediction `distance` places after the next one left: most likely
@@ -43,21 +46,107 @@ impl ImpactQueue {
 
     /// The earliest impact predicted during the step: it may be taken next.
     pub fn earliest_later(&self) -> Option<&Impact> {
-        self.later.peek().map(|Reverse(impact)| impact)
+        self.later.earliest()
     }
 
     /// Takes the earliest impact left.
     pub fn pop(&mut self) -> Option<Impact> {
         let first = self.sorted.get(self.next);
-        match (first, self.later.peek()) {
-            (Some(first), Some(Reverse(later))) if later < first => {
-                self.later.pop().map(|Reverse(impact)| impact)
-            }
+        match (first, self.later.earliest()) {
+            (Some(first), Some(later)) if later < first => self.later.pop(),
             (Some(&first), _) => {
                 self.next += 1;
                 Some(first)
             }
-            (None, _) => self.later.pop().map(|Reverse(impact)| impact),
+            (None, _) => self.later.pop(),
+        }
+    }
+}
+
+/// Impacts in buckets of time: those of the bucket taken now (`current`) in a heap, each later
+/// bucket's in a list, heaped when its turn comes. The bucket of a time never decreases as the
+/// time grows (in `f64::total_cmp`'s order), so every impact in a later bucket comes after
+/// every one in an earlier bucket. An impact pushed for a bucket already passed (a time
+/// before the current bucket's) goes into the heap, which orders it with the rest.
+#[derive(Debug, Default)]
+struct Buckets {
+    heap: BinaryHeap<Reverse<Impact>>,
+    lists: Vec<Vec<Impact>>,
+    /// The bucket whose impacts are in the heap; while the heap is empty, every list is too.
+    current: usize,
+    /// Buckets per second.
+    scale: f64,
+}
+
+/// About this many impacts predicted at a step's start per bucket: the buckets in use then
+/// hold about as many of the impacts predicted during the step.
+const IMPACTS_PER_BUCKET: usize = 64;
+
+/// Buckets at most: the lists' heads stay in the cache.
+const MAX_BUCKETS: usize = 4096;
+
+impl Buckets {
+    /// Empty, in buckets over `horizon` seconds, as many as suit a step that started with
+    /// `first` impacts.
+    fn start(&mut self, horizon: f64, first: usize) {
+        let count = (first / IMPACTS_PER_BUCKET).clamp(1, MAX_BUCKETS);
+        self.lists.resize_with(count, Vec::new);
+        self.lists.truncate(count);
+        self.lists.iter_mut().for_each(Vec::clear);
+        self.heap.clear();
+        self.current = 0;
+        // A horizon that is not a positive number puts everything into one bucket.
+        self.scale = if horizon > 0.0 && horizon.is_finite() {
+            count as f64 / horizon
+        } else {
+            0.0
+        };
+    }
+
+    /// The bucket of an impact at `time`: never smaller for a later time.
+    fn bucket_of(&self, time: f64) -> usize {
+        let last = self.lists.len().saturating_sub(1);
+        if time.is_nan() && time.is_sign_positive() {
+            return last; // after every other time
+        }
+        // `as` rounds down and saturates: a negative time (or NaN) to 0, a huge one to the max.
+        ((time * self.scale) as usize).min(last)
+    }
+
+    fn earliest(&self) -> Option<&Impact> {
+        self.heap.peek().map(|Reverse(impact)| impact)
+    }
+
+    fn push(&mut self, impact: Impact) {
+        let bucket = self.bucket_of(impact.time);
+        if self.heap.is_empty() {
+            // Every list is empty too: the impact's bucket becomes the current one.
+            self.current = bucket;
+        }
+        if bucket <= self.current {
+            self.heap.push(Reverse(impact));
+        } else {
+            self.lists[bucket].push(impact);
+        }
+    }
+
+    fn pop(&mut self) -> Option<Impact> {
+        let Reverse(impact) = self.heap.pop()?;
+        if self.heap.is_empty() {
+            self.take_next_bucket();
+        }
+        Some(impact)
+    }
+
+    /// The heap emptied: the next bucket with impacts, if any, becomes the current one.
+    fn take_next_bucket(&mut self) {
+        let next = (self.current + 1..self.lists.len()).find(|&k| !self.lists[k].is_empty());
+        if let Some(next) = next {
+            self.current = next;
+            // The heap's buffer is reused: the list's impacts move over and are heaped.
+            let mut buffer = std::mem::take(&mut self.heap).into_vec();
+            buffer.extend(self.lists[next].drain(..).map(Reverse));
+            self.heap = BinaryHeap::from(buffer);
         }
     }
 }
@@ -72,43 +161,93 @@ mod tests {
 
     #[test]
     fn the_two_sources_come_out_as_one_heap_of_them_all_would() {
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut impact = |time: f64| {
-            let ball = |rng: &mut ChaCha8Rng| {
-                let index = rng.random_range(0..50u32);
-                Party {
-                    slot: index as usize,
-                    index,
-                    hits: rng.random_range(0..3),
-                }
+        // The buckets span the step's first impacts (0.4 s), a tenth of it, ten times it, or
+        // nothing (one bucket).
+        for horizon in [0.4, 0.04, 4.0, 0.0, f64::NAN] {
+            let mut rng = ChaCha8Rng::seed_from_u64(5);
+            let mut impact = |time: f64| {
+                let ball = |rng: &mut ChaCha8Rng| {
+                    let index = rng.random_range(0..50u32);
+                    Party {
+                        slot: index as usize,
+                        index,
+                        hits: rng.random_range(0..3),
+                    }
+                };
+                let (i, j) = (ball(&mut rng), ball(&mut rng));
+                Impact::between(time, i, j)
             };
-            let (i, j) = (ball(&mut rng), ball(&mut rng));
-            Impact::between(time, i, j)
-        };
-        // Equal times on purpose: the balls' order must break the ties the same way.
-        let first: Vec<Impact> = (0..300).map(|k| impact((k % 40) as f64 * 0.01)).collect();
-        let mut queue = ImpactQueue::default();
-        queue.start(first.iter().copied());
-        let mut heap: BinaryHeap<Reverse<Impact>> = first.iter().copied().map(Reverse).collect();
-        let (mut taken, mut expected) = (Vec::new(), Vec::new());
-        for round in 0..600 {
-            // Now and then an impact predicted during the step, never before the last taken.
-            if round % 3 == 0 {
-                let now = taken.last().map_or(0.0, |i: &Impact| i.time);
-                let later = impact(now + (round % 7) as f64 * 0.005);
-                queue.push(later);
-                heap.push(Reverse(later));
-            }
-            match (queue.pop(), heap.pop()) {
-                (Some(a), Some(Reverse(b))) => {
-                    taken.push(a);
-                    expected.push(b);
+            // Equal times on purpose: the balls' order must break the ties the same way.
+            let first: Vec<Impact> = (0..3000).map(|k| impact((k % 40) as f64 * 0.01)).collect();
+            let mut queue = ImpactQueue::default();
+            queue.start(first.iter().copied(), horizon);
+            let buckets = queue.later.lists.len();
+            let mut heap: BinaryHeap<Reverse<Impact>> =
+                first.iter().copied().map(Reverse).collect();
+            let (mut taken, mut expected) = (Vec::new(), Vec::new());
+            let mut most_waiting = 0;
+            for round in 0..6000 {
+                // Now and then an impact predicted during the step: mostly at or after the
+                // last taken, a few before it (a bucket already passed) or past the horizon.
+                if round % 3 == 0 {
+                    let now = taken.last().map_or(0.0, |i: &Impact| i.time);
+                    let time = match round % 100 {
+                        0 => now - 0.003,
+                        51 => 0.45,
+                        _ => now + (round % 7) as f64 * 0.005,
+                    };
+                    let later = impact(time);
+                    queue.push(later);
+                    heap.push(Reverse(later));
+                    let waiting = queue.later.lists.iter().map(Vec::len).sum::<usize>();
+                    most_waiting = most_waiting.max(waiting);
                 }
-                (None, None) => break,
-                (a, b) => panic!("one source ran dry first: {a:?} {b:?}"),
+                match (queue.pop(), heap.pop()) {
+                    (Some(a), Some(Reverse(b))) => {
+                        taken.push(a);
+                        expected.push(b);
+                    }
+                    (None, None) => break,
+                    (a, b) => panic!("one source ran dry first: {a:?} {b:?}"),
+                }
             }
+            assert!(taken.len() > 4000, "{} taken", taken.len());
+            assert_eq!(taken, expected, "horizon {horizon}");
+            // The lists held impacts waiting for their bucket, unless there was one bucket.
+            assert_eq!(buckets, 3000 / IMPACTS_PER_BUCKET);
+            assert_eq!(
+                most_waiting > 0,
+                horizon > 0.0,
+                "{most_waiting} waiting at most"
+            );
         }
-        assert!(taken.len() > 400, "{} taken", taken.len());
-        assert_eq!(taken, expected);
+    }
+
+    #[test]
+    fn a_later_time_never_falls_into_an_earlier_bucket() {
+        let mut buckets = Buckets::default();
+        buckets.start(1.0 / 60.0, 100_000);
+        let times = [
+            -f64::NAN,
+            f64::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-300,
+            0.004,
+            1.0 / 60.0 - 1e-18,
+            1.0 / 60.0,
+            0.02,
+            1e300,
+            f64::INFINITY,
+            f64::NAN,
+        ];
+        let found: Vec<usize> = times.iter().map(|&t| buckets.bucket_of(t)).collect();
+        assert!(found.is_sorted(), "{found:?}");
+        assert_eq!((found[0], found[12]), (0, buckets.lists.len() - 1));
+        assert!(
+            found[6] > 0 && found[6] < buckets.lists.len() - 1,
+            "{found:?}"
+        );
     }
 }

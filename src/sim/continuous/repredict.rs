@@ -156,7 +156,7 @@ mod tests {
         let mut both = Timeline::default();
         for timeline in [&mut one_at_a_time, &mut both] {
             timeline.predict(&circles, &velocities, &held, spec);
-            timeline.start();
+            timeline.start(spec.dt);
         }
         // Each ball impact gives its balls new velocities, at random (so that they may still
         // approach); every fifth one's second ball takes its last hit, which the search for

@@ -62,7 +62,7 @@ impl Timeline {
         spec: StepSpec,
         on_hit: &mut impl FnMut(Hit),
     ) {
-        self.start();
+        self.start(spec.dt);
         let mut last = None;
         let prefetching = self.worth_prefetching();
         while let Some(impact) = self.queue.pop() {
@@ -104,8 +104,8 @@ impl Timeline {
     }
 
     /// Every ball at the start of the step (placed by [`predict`](Self::predict)), no hits
-    /// yet; the predictions queued.
-    pub(super) fn start(&mut self) {
+    /// yet; the predictions queued. `dt` is the step's length.
+    pub(super) fn start(&mut self, dt: f64) {
         self.paths.reset(&self.grid);
         self.queue.start(
             self.predictions
@@ -114,6 +114,7 @@ impl Timeline {
                     Prediction::Impact(impact) => Some(impact),
                     Prediction::Overlap(..) => None,
                 }),
+            dt,
         );
         self.overlapping.clear();
         for prediction in &self.predictions {
