@@ -14,8 +14,9 @@ use crate::sim::cache::prefetch;
 const PREFETCH_DISTANCE: usize = 4;
 
 /// Below this many balls the timeline's arrays (about 130 B a ball) mostly fit the cache, and
-/// [`Timeline::prefetch_coming`] only costs: 1–2% at 1,000 and 10,000 balls, where from
-/// 30,000 on it gains (README, *Prefetching the coming impacts*).
+/// [`Timeline::prefetch_coming`] only costs: 1–2% at 1,000 and 10,000 balls with the plain
+/// loads it first made, 1–3% with the prefetch instruction (four rounds), where from 30,000
+/// on it gains (README, *Prefetching the coming impacts*).
 const PREFETCH_MIN_BALLS: usize = 20_000;
 
 impl Timeline {
