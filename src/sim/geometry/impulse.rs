@@ -11,6 +11,7 @@ use bevy::math::DVec2;
 
 use super::circle::{Circle, ContactGeometry, circle_contact};
 use super::pairs::IndexedContact;
+use crate::sim::cache::prefetch;
 use crate::sim::params::MassModel;
 
 /// The result of [`normal_exchange`]: the new velocities and what the hit carried.
@@ -102,14 +103,15 @@ pub fn resolve_overlaps(
     constants: (MassModel, f64, f64),
     on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
-    let pairs = pairs.into_iter().map(|(a, b)| (a, b, None));
+    let pairs = pairs.into_iter().map(|(a, b)| (a, b, None, None));
     resolve_known_overlaps(pairs, circles, velocities, held, constants, on_exchange);
 }
 
 /// [`resolve_overlaps`] for `contacts` as [`find_contacts`](super::pairs::find_contacts) found
 /// them, marking in `touched` the balls of each as it is taken. A contact neither of whose
 /// balls an earlier one touched is still where it was found, so its geometry is used as found:
-/// the same result, without working it out again.
+/// the same result, without working it out again. For many balls, each contact's balls are
+/// loaded a few contacts ahead ([`prefetch`]): they lie anywhere in the arrays.
 pub fn resolve_found_contacts(
     contacts: &[IndexedContact],
     touched: &mut [bool],
@@ -119,26 +121,43 @@ pub fn resolve_found_contacts(
     constants: (MassModel, f64, f64),
     on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
-    let pairs = contacts.iter().map(|contact| {
+    let loading_ahead = circles.len() >= PREFETCH_MIN_BALLS;
+    let pairs = contacts.iter().enumerate().map(|(k, contact)| {
         let (a, b) = (contact.a as usize, contact.b as usize);
         let untouched = !touched[a] && !touched[b];
         (touched[a], touched[b]) = (true, true);
-        (contact.a, contact.b, untouched.then_some(contact.geometry))
+        let coming = contacts
+            .get(k + PREFETCH_DISTANCE)
+            .filter(|_| loading_ahead)
+            .map(|coming| (coming.a, coming.b));
+        let known = untouched.then_some(contact.geometry);
+        (contact.a, contact.b, known, coming)
     });
     resolve_known_overlaps(pairs, circles, velocities, held, constants, on_exchange);
 }
 
-/// [`resolve_overlaps`] for pairs `(a, b, known)` that may come with their contact's geometry,
-/// `known`, when neither ball has moved since it was found.
+/// How many contacts ahead [`resolve_found_contacts`] loads a contact's balls.
+const PREFETCH_DISTANCE: usize = 8;
+
+/// Below this many balls [`resolve_found_contacts`] loads nothing ahead: the arrays mostly
+/// fit the cache, and the loads would only cost.
+const PREFETCH_MIN_BALLS: usize = 20_000;
+
+/// [`resolve_overlaps`] for pairs `(a, b, known, coming)` that may come with their contact's
+/// geometry, `known`, when neither ball has moved since it was found, and with the balls of
+/// a pair to come, `coming`, whose circles and velocities are loaded into the cache.
 fn resolve_known_overlaps(
-    pairs: impl IntoIterator<Item = (u32, u32, Option<ContactGeometry>)>,
+    pairs: impl IntoIterator<Item = (u32, u32, Option<ContactGeometry>, Option<(u32, u32)>)>,
     circles: &mut [Circle],
     velocities: &mut [DVec2],
     held: &mut [bool],
     (mass_model, restitution, rest_speed): (MassModel, f64, f64),
     mut on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
-    for (a, b, known) in pairs {
+    for (a, b, known, coming) in pairs {
+        if let Some(coming) = coming {
+            load_ahead(coming, circles, velocities);
+        }
         let (ia, ib) = (a as usize, b as usize);
         if held[ia] && held[ib] {
             continue;
@@ -177,6 +196,14 @@ fn resolve_known_overlaps(
             geometry,
             (inverse_mass_a, inverse_mass_b),
         );
+    }
+}
+
+/// Brings the circles and velocities of the pair of balls `(a, b)` into the cache.
+fn load_ahead((a, b): (u32, u32), circles: &[Circle], velocities: &[DVec2]) {
+    for ball in [a as usize, b as usize] {
+        prefetch(circles.get(ball));
+        prefetch(velocities.get(ball));
     }
 }
 
