@@ -5,7 +5,7 @@
 //! [`Timeline::prefetch_coming`] before each impact; nothing here changes a result.
 
 use super::impact::Impact;
-use super::state::Timeline;
+use super::state::{Mover, Timeline};
 use crate::sim::cache::prefetch;
 
 /// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
@@ -47,17 +47,19 @@ impl Timeline {
 
     /// Loads the movers of `impact`'s balls and the first one's slot in the grid.
     fn prefetch_balls(&self, impact: Impact) {
-        // A mover spans two cache lines: its first field and its last but one bring both
-        // (its layout is fixed: `repr(C)`).
-        let load = |slot: u32| {
-            let mover = self.movers.get(slot as usize);
-            prefetch(mover.map(|mover| &mover.center));
-            prefetch(mover.map(|mover| &mover.hits));
-        };
-        load(impact.a);
+        prefetch_mover(&self.movers, impact.a);
         if impact.wall().is_none() {
-            load(impact.other);
+            prefetch_mover(&self.movers, impact.other);
         }
         self.grid.prefetch_slot(impact.a as usize);
     }
+}
+
+/// Loads the mover in `slot`, if any.
+pub(super) fn prefetch_mover(movers: &[Mover], slot: u32) {
+    // A mover spans two cache lines: its first field and its last but one bring both (its
+    // layout is fixed: `repr(C)`).
+    let mover = movers.get(slot as usize);
+    prefetch(mover.map(|mover| &mover.center));
+    prefetch(mover.map(|mover| &mover.hits));
 }

@@ -185,6 +185,9 @@ pub struct Timeline {
     pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.
     pub(super) fallback: Vec<IndexedContact>,
+    /// The balls the search after an impact found, `(which of its two balls, slot)`, before
+    /// each is timed (`Timeline::predict_for_both`).
+    pub(super) found: Vec<(u8, u32)>,
     /// Whether the last run handled some impact after one that comes later in the impacts'
     /// order (see `Impact`'s `Ord`): then its hits are not in that order.
     pub(super) out_of_order: bool,
