@@ -140,7 +140,8 @@ pub fn resolve_found_contacts(
 const PREFETCH_DISTANCE: usize = 8;
 
 /// Below this many balls [`resolve_found_contacts`] loads nothing ahead: the arrays mostly
-/// fit the cache, and the loads would only cost.
+/// fit the cache, and the loads only cost (1–2% of the discrete step at 1,000 and 10,000
+/// balls, four rounds), as the continuous timeline's do below the same count.
 const PREFETCH_MIN_BALLS: usize = 20_000;
 
 /// [`resolve_overlaps`] for pairs `(a, b, known, coming)` that may come with their contact's
