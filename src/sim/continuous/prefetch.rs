@@ -6,21 +6,17 @@
 
 use super::impact::Impact;
 use super::state::{Mover, Timeline};
-use crate::sim::cache::prefetch;
+use crate::sim::cache::{PREFETCH_MIN_BALLS, prefetch};
 
 /// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
 /// cells around a ball (and twice as many ahead, the balls themselves): 2 and 8 did as well
 /// at a million balls.
 const PREFETCH_DISTANCE: usize = 4;
 
-/// Below this many balls the timeline's arrays (about 130 B a ball) mostly fit the cache, and
-/// [`Timeline::prefetch_coming`] only costs: 1–2% at 1,000 and 10,000 balls with the plain
-/// loads it first made, 1–3% with the prefetch instruction (four rounds), where from 30,000
-/// on it gains (README, *Prefetching the coming impacts*).
-const PREFETCH_MIN_BALLS: usize = 20_000;
-
 impl Timeline {
-    /// Whether this step's balls are enough for the loads to pay ([`PREFETCH_MIN_BALLS`]).
+    /// Whether this step's balls are enough for the loads to pay ([`PREFETCH_MIN_BALLS`]:
+    /// below it, 1–2% at 1,000 and 10,000 balls with the plain loads the timeline first made,
+    /// 1–3% with the prefetch instruction; the timeline's arrays are about 130 B a ball).
     pub(super) fn worth_prefetching(&self) -> bool {
         self.movers.len() >= PREFETCH_MIN_BALLS
     }
