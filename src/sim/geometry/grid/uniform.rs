@@ -12,6 +12,7 @@ use bevy::math::DVec2;
 use super::cells::CellMap;
 use super::counting::{NO_CELL, sort_into_cells};
 use super::rows::RowLists;
+use super::touching::for_each_touching;
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
     BALLS_PER_PIECE, carve, in_pieces, piece_ranges, split_evenly, threads_at_work, worth_splitting,
@@ -294,9 +295,10 @@ impl UniformGrid {
     }
 
     /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls in the same or
-    /// adjacent cells, and every pair with a big ball whose circles' boxes might meet, in a
-    /// fixed order (the big balls' own pairs first, then row by row). Indices are the
-    /// positions in the slice given to [`rebuild`](Self::rebuild).
+    /// adjacent cells whose circles touch (tested a run at a time, `touching.rs`), and every
+    /// pair with a big ball whose circles' boxes might meet, in a fixed order (the big balls'
+    /// own pairs first, then row by row). Indices are the positions in the slice given to
+    /// [`rebuild`](Self::rebuild).
     pub fn for_each_candidate_pair(&self, visit: impl FnMut(u32, u32, Circle, Circle)) {
         self.for_each_candidate_pair_in_rows(0..self.rows(), visit);
     }
@@ -316,7 +318,8 @@ impl UniformGrid {
         }
         // In row-major order a cell and its right neighbour are adjacent, and the three cells
         // above (left, centre, right) are one contiguous run: each ball's candidates are two
-        // contiguous slot ranges, the rest of its own cell with the right cell, and the run above.
+        // contiguous slot ranges, the rest of its own cell with the right cell, and the run
+        // above, each tested without a branch per candidate.
         let columns = self.cells.columns;
         for row in rows {
             for column in 0..columns {
@@ -339,14 +342,15 @@ impl UniformGrid {
                 };
                 for slot in start..end {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-                    // Two plain loops over slices: no bounds checks and no chained iterator.
                     for range in [slot + 1..same_row_end, above.clone()] {
-                        let others = self.sorted_index[range.clone()]
-                            .iter()
-                            .zip(&self.sorted_circle[range]);
-                        for (&other_index, &other) in others {
-                            visit(index, other_index, circle, other);
-                        }
+                        for_each_touching(circle, range, &self.sorted_circle, |other| {
+                            visit(
+                                index,
+                                self.sorted_index[other],
+                                circle,
+                                self.sorted_circle[other],
+                            );
+                        });
                     }
                 }
             }
