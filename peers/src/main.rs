@@ -4,6 +4,7 @@
 //! built by `cargo test` or CI: `cargo run --release -p peers -- --scene FILE`.
 
 mod box2d;
+mod edmd;
 mod rapier;
 mod scene;
 
@@ -31,6 +32,8 @@ pub trait Engine {
 enum Engines {
     Box2d,
     Rapier,
+    /// The persistent event-driven reference (`edmd.rs`): an experiment, not in `all`.
+    Edmd,
     All,
 }
 
@@ -102,6 +105,7 @@ fn main() {
     let kinds: &[&'static str] = match cli.engine {
         Engines::Box2d => &["box2d"],
         Engines::Rapier => &["rapier"],
+        Engines::Edmd => &["edmd"],
         Engines::All => &["box2d", "rapier"],
     };
     if !cli.json {
@@ -112,6 +116,13 @@ fn main() {
     for &kind in kinds {
         let mut engine: Box<dyn Engine> = match kind {
             "box2d" => Box::new(box2d::Box2d::new(&scene).expect("box2d world")),
+            "edmd" => match edmd::Edmd::new(&scene) {
+                Ok(edmd) => Box::new(edmd),
+                Err(error) => {
+                    eprintln!("peers: {error}");
+                    std::process::exit(1);
+                }
+            },
             _ => Box::new(rapier::Rapier::new(&scene)),
         };
         let report = run(kind, engine.as_mut(), &scene, cli.steps, cli.warmup);

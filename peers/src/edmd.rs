@@ -1,0 +1,533 @@
+//! A persistent event-driven reference, an experiment for issue 14: what ballpit's exact mode
+//! would cost if its timeline ran on from step to step instead of being predicted afresh each
+//! step. Hard discs, elastic, no gravity (the standard gas; other scenes are refused).
+//!
+//! Every ball keeps its path (where it was at its own clock, and its velocity) and a count of
+//! the times it changed. Each change schedules the ball's wall impact, the moment it leaves its
+//! cell and every approaching neighbour's impact, tagged with both counts; an event whose
+//! balls changed since it was scheduled is stale and skipped. A ball leaving its cell keeps its
+//! path and its events and is predicted against the cells it comes next to; two balls that meet
+//! are in neighbouring cells when they do, so each pair is predicted in time. A step takes
+//! every event up to its end, then works out every ball's place at the end of the step, as
+//! ballpit writes every ball back each step. The events wait in a calendar queue: buckets of
+//! time in a ring, the current one a binary heap.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use bevy::math::DVec2;
+
+use crate::Engine;
+use crate::scene::{Ball, Scene};
+
+/// No ball: the end of a cell's list.
+const NONE: u32 = u32::MAX;
+/// An event's `other` for a wall (`WALL + axis`) or a cell left (`CROSS + axis * 2 + upward`).
+const WALL: u32 = u32::MAX - 8;
+const CROSS: u32 = u32::MAX - 4;
+
+#[derive(Clone, Copy, Debug)]
+struct Event {
+    time: f64,
+    ball: u32,
+    other: u32,
+    count: u32,
+    other_count: u32,
+}
+
+impl PartialEq for Event {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Event {}
+impl PartialOrd for Event {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Event {
+    /// Reversed, so that the heap gives the earliest first; ties by the balls.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .time
+            .total_cmp(&self.time)
+            .then(other.ball.cmp(&self.ball))
+            .then(other.other.cmp(&self.other))
+    }
+}
+
+/// A ball's path (where it was at its clock, and its velocity) and its place in the cells.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Disc {
+    position: DVec2,
+    velocity: DVec2,
+    clock: f64,
+    radius: f64,
+    /// How many times its path changed.
+    count: u32,
+    cell: u32,
+    next: u32,
+    prev: u32,
+}
+
+pub struct Edmd {
+    /// The scene's number of each ball.
+    order: Vec<usize>,
+    /// Each ball's path and place, one cache line a ball.
+    discs: Vec<Disc>,
+    inverse_mass: Vec<f64>,
+    head: Vec<u32>,
+    columns: usize,
+    rows: usize,
+    cell_size: f64,
+    size: DVec2,
+    now: f64,
+    dt: f64,
+    events: Calendar,
+    out: Vec<DVec2>,
+}
+
+impl Edmd {
+    pub fn new(scene: &Scene) -> Result<Self, String> {
+        if scene.gravity != DVec2::ZERO || scene.restitution != 1.0 {
+            return Err("the event-driven reference runs elastic scenes without gravity".into());
+        }
+        let count = scene.balls.len();
+        let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let cell_size = (2.0 * largest).max(1e-9);
+        let columns = ((scene.size.x / cell_size) as usize).max(1);
+        let rows = ((scene.size.y / cell_size) as usize).max(1);
+        let cell_size = (scene.size.x / columns as f64).max(scene.size.y / rows as f64);
+        // Numbered in cell order, so that neighbours lie near each other in memory.
+        let cell_of = |b: &Ball| {
+            let column = ((b.position.x / cell_size) as usize).min(columns - 1);
+            let row = ((b.position.y / cell_size) as usize).min(rows - 1);
+            row * columns + column
+        };
+        let mut order: Vec<usize> = (0..count).collect();
+        order.sort_by_key(|&k| cell_of(&scene.balls[k]));
+        let balls: Vec<Ball> = order.iter().map(|&k| scene.balls[k]).collect();
+        let mut edmd = Edmd {
+            order,
+            discs: (balls.iter())
+                .map(|b| Disc {
+                    position: b.position,
+                    velocity: b.velocity,
+                    clock: 0.0,
+                    radius: b.radius,
+                    count: 0,
+                    cell: NONE,
+                    next: NONE,
+                    prev: NONE,
+                })
+                .collect(),
+            inverse_mass: (balls.iter())
+                .map(|b| 1.0 / scene.mass_model.mass(b.radius))
+                .collect(),
+            head: vec![NONE; columns * rows],
+            columns,
+            rows,
+            cell_size,
+            size: scene.size,
+            now: 0.0,
+            dt: scene.dt,
+            events: Calendar::new(scene.dt / (count / 400).clamp(8, 4096) as f64),
+            out: balls.iter().map(|b| b.position).collect(),
+        };
+        for ball in 0..count {
+            let cell = edmd.cell_at(edmd.discs[ball].position);
+            edmd.insert(ball, cell);
+        }
+        for ball in 0..count {
+            edmd.predict_walls_and_cells(ball);
+            let cells = edmd.neighbourhood(edmd.discs[ball].cell as usize);
+            edmd.predict_pairs_in(ball, cells, f64::INFINITY, true);
+        }
+        Ok(edmd)
+    }
+
+    fn cell_at(&self, point: DVec2) -> usize {
+        let column = ((point.x / self.cell_size) as usize).min(self.columns - 1);
+        let row = ((point.y / self.cell_size) as usize).min(self.rows - 1);
+        row * self.columns + column
+    }
+
+    fn insert(&mut self, ball: usize, cell: usize) {
+        let first = self.head[cell];
+        self.discs[ball].next = first;
+        self.discs[ball].prev = NONE;
+        if first != NONE {
+            self.discs[first as usize].prev = ball as u32;
+        }
+        self.head[cell] = ball as u32;
+        self.discs[ball].cell = cell as u32;
+    }
+
+    fn remove(&mut self, ball: usize) {
+        let (prev, next) = (self.discs[ball].prev, self.discs[ball].next);
+        if prev != NONE {
+            self.discs[prev as usize].next = next;
+        } else {
+            self.head[self.discs[ball].cell as usize] = next;
+        }
+        if next != NONE {
+            self.discs[next as usize].prev = prev;
+        }
+    }
+
+    /// The cells around `cell` (itself included), as (columns, rows) ranges.
+    fn neighbourhood(&self, cell: usize) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+        let (column, row) = (cell % self.columns, cell / self.columns);
+        (
+            column.saturating_sub(1)..(column + 2).min(self.columns),
+            row.saturating_sub(1)..(row + 2).min(self.rows),
+        )
+    }
+
+    fn at(&self, ball: usize, time: f64) -> DVec2 {
+        self.discs[ball].position + self.discs[ball].velocity * (time - self.discs[ball].clock)
+    }
+
+    fn advance(&mut self, ball: usize, time: f64) {
+        self.discs[ball].position = self.at(ball, time);
+        self.discs[ball].clock = time;
+    }
+
+    fn schedule(&mut self, time: f64, ball: usize, other: u32, other_count: u32) {
+        self.events.push(Event {
+            time,
+            ball: ball as u32,
+            other,
+            count: self.discs[ball].count,
+            other_count,
+        });
+    }
+
+    /// The ball's next wall impact and the moment it leaves its cell, which it returns.
+    fn predict_walls_and_cells(&mut self, ball: usize) -> f64 {
+        let (p, v, r) = (
+            self.at(ball, self.now),
+            self.discs[ball].velocity,
+            self.discs[ball].radius,
+        );
+        let cell = self.discs[ball].cell as usize;
+        let corner = DVec2::new(
+            (cell % self.columns) as f64 * self.cell_size,
+            (cell / self.columns) as f64 * self.cell_size,
+        );
+        let last = DVec2::new((self.columns - 1) as f64, (self.rows - 1) as f64) * self.cell_size;
+        let (mut wall, mut wall_axis) = (f64::INFINITY, 0);
+        let (mut cross, mut cross_code) = (f64::INFINITY, 0);
+        for axis in 0..2 {
+            let speed = v[axis];
+            if speed > 0.0 {
+                let t = ((self.size[axis] - r - p[axis]) / speed).max(0.0);
+                if t < wall {
+                    (wall, wall_axis) = (t, axis);
+                }
+                if corner[axis] < last[axis] {
+                    let t = ((corner[axis] + self.cell_size - p[axis]) / speed).max(0.0);
+                    if t < cross {
+                        (cross, cross_code) = (t, axis * 2 + 1);
+                    }
+                }
+            } else if speed < 0.0 {
+                let t = ((r - p[axis]) / speed).max(0.0);
+                if t < wall {
+                    (wall, wall_axis) = (t, axis);
+                }
+                if corner[axis] > 0.0 {
+                    let t = ((corner[axis] - p[axis]) / speed).max(0.0);
+                    if t < cross {
+                        (cross, cross_code) = (t, axis * 2);
+                    }
+                }
+            }
+        }
+        // A wall further off than the cell's edge is predicted again from the next cell.
+        if wall.is_finite() && wall <= cross {
+            self.schedule(self.now + wall, ball, WALL + wall_axis as u32, 0);
+        }
+        if cross.is_finite() {
+            self.schedule(self.now + cross, ball, CROSS + cross_code as u32, 0);
+        }
+        self.now + cross
+    }
+
+    /// Every approaching ball in the cells `(columns, rows)` that it meets before `until` (when
+    /// it leaves its cell: it is predicted again then); at the start, each pair once.
+    fn predict_pairs_in(
+        &mut self,
+        ball: usize,
+        (columns, rows): (std::ops::Range<usize>, std::ops::Range<usize>),
+        until: f64,
+        only_later: bool,
+    ) {
+        let (p, v, r) = (
+            self.at(ball, self.now),
+            self.discs[ball].velocity,
+            self.discs[ball].radius,
+        );
+        for row in rows {
+            for column in columns.clone() {
+                let mut other = self.head[row * self.columns + column];
+                while other != NONE {
+                    let o = other as usize;
+                    other = self.discs[o].next;
+                    if o == ball || (only_later && o < ball) {
+                        continue;
+                    }
+                    let dp = self.at(o, self.now) - p;
+                    let dv = self.discs[o].velocity - v;
+                    let b = dp.dot(dv);
+                    if b >= 0.0 {
+                        continue;
+                    }
+                    let sigma = r + self.discs[o].radius;
+                    let c = dp.length_squared() - sigma * sigma;
+                    let a = dv.length_squared();
+                    let discriminant = b * b - a * c;
+                    if discriminant < 0.0 {
+                        continue;
+                    }
+                    let t = (c / (-b + discriminant.sqrt())).max(0.0);
+                    if self.now + t <= until {
+                        self.schedule(self.now + t, ball, o as u32, self.discs[o].count);
+                    }
+                }
+            }
+        }
+    }
+
+    fn changed(&mut self, ball: usize) {
+        self.discs[ball].count += 1;
+        self.predict_around(ball);
+    }
+
+    fn predict_around(&mut self, ball: usize) {
+        self.predict_walls_and_cells(ball);
+        let cells = self.neighbourhood(self.discs[ball].cell as usize);
+        self.predict_pairs_in(ball, cells, f64::INFINITY, false);
+    }
+
+    fn handle(&mut self, event: Event) {
+        let ball = event.ball as usize;
+        if self.discs[ball].count != event.count {
+            return;
+        }
+        self.now = event.time;
+        if event.other >= CROSS {
+            self.advance(ball, event.time);
+            let code = (event.other - CROSS) as usize;
+            let (axis, upward) = (code / 2, code % 2 == 1);
+            let cell = self.discs[ball].cell as usize;
+            let step = if axis == 0 { 1 } else { self.columns };
+            let new_cell = if upward { cell + step } else { cell - step };
+            self.remove(ball);
+            self.insert(ball, new_cell);
+            // Its paths stay, and so do its events: only the cells it now comes next to.
+            let (mut columns, mut rows) = self.neighbourhood(new_cell);
+            let (column, row) = (new_cell % self.columns, new_cell / self.columns);
+            let far_side = |at: usize, up: bool, limit: usize| {
+                let far = if up { at + 1 } else { at.wrapping_sub(1) };
+                if far < limit { far..far + 1 } else { 0..0 }
+            };
+            if axis == 0 {
+                columns = far_side(column, upward, self.columns);
+            } else {
+                rows = far_side(row, upward, self.rows);
+            }
+            self.predict_walls_and_cells(ball);
+            self.predict_pairs_in(ball, (columns, rows), f64::INFINITY, false);
+        } else if event.other >= WALL {
+            let axis = (event.other - WALL) as usize;
+            self.advance(ball, event.time);
+            self.discs[ball].velocity[axis] = -self.discs[ball].velocity[axis];
+            self.changed(ball);
+        } else {
+            let other = event.other as usize;
+            if self.discs[other].count != event.other_count {
+                return;
+            }
+            self.advance(ball, event.time);
+            self.advance(other, event.time);
+            let offset = self.discs[other].position - self.discs[ball].position;
+            let normal = offset.normalize_or(DVec2::X);
+            let closing = (self.discs[other].velocity - self.discs[ball].velocity).dot(normal);
+            if closing < 0.0 {
+                let (ia, ib) = (self.inverse_mass[ball], self.inverse_mass[other]);
+                let impulse = -2.0 * closing / (ia + ib);
+                self.discs[ball].velocity -= normal * (impulse * ia);
+                self.discs[other].velocity += normal * (impulse * ib);
+            }
+            self.changed(ball);
+            self.changed(other);
+        }
+    }
+}
+
+impl Engine for Edmd {
+    fn step(&mut self) {
+        let end = self.now + self.dt;
+        loop {
+            let discs = &self.discs;
+            let is_current = |event: &Event| {
+                discs[event.ball as usize].count == event.count
+                    && (event.other >= WALL
+                        || discs[event.other as usize].count == event.other_count)
+            };
+            let Some(event) = self.events.pop_until(end, is_current) else {
+                break;
+            };
+            self.handle(event);
+        }
+        self.now = end;
+        for ball in 0..self.out.len() {
+            self.out[ball] = self.at(ball, end);
+        }
+    }
+
+    fn balls(&mut self) -> Vec<Ball> {
+        let mut balls = vec![
+            Ball {
+                position: DVec2::ZERO,
+                velocity: DVec2::ZERO,
+                radius: 0.0
+            };
+            self.out.len()
+        ];
+        for ball in 0..self.out.len() {
+            balls[self.order[ball]] = Ball {
+                position: self.at(ball, self.now),
+                velocity: self.discs[ball].velocity,
+                radius: self.discs[ball].radius,
+            };
+        }
+        balls
+    }
+}
+
+/// Buckets of time in a ring of `RING`, each a plain list until its turn, then a heap; events
+/// past the ring wait in `far` until it comes round. Pops in the order one heap would.
+struct Calendar {
+    width: f64,
+    ring: Vec<Vec<Event>>,
+    current: BinaryHeap<Event>,
+    /// The bucket `current` holds (and every earlier one, emptied).
+    at: u64,
+    far: Vec<Event>,
+}
+
+const RING: u64 = 4096;
+
+impl Calendar {
+    fn new(width: f64) -> Self {
+        Calendar {
+            width,
+            ring: (0..RING).map(|_| Vec::new()).collect(),
+            current: BinaryHeap::new(),
+            at: 0,
+            far: Vec::new(),
+        }
+    }
+
+    fn bucket(&self, time: f64) -> u64 {
+        (time / self.width) as u64
+    }
+
+    fn push(&mut self, event: Event) {
+        let bucket = self.bucket(event.time);
+        if bucket <= self.at {
+            self.current.push(event);
+        } else if bucket < self.at + RING {
+            self.ring[(bucket % RING) as usize].push(event);
+        } else {
+            self.far.push(event);
+        }
+    }
+
+    /// The earliest event, if it comes by `end`. A bucket's events that are no longer
+    /// `is_current` are dropped when its turn comes, before they are heaped.
+    fn pop_until(&mut self, end: f64, is_current: impl Fn(&Event) -> bool) -> Option<Event> {
+        loop {
+            if let Some(top) = self.current.peek() {
+                return if top.time <= end {
+                    self.current.pop()
+                } else {
+                    None
+                };
+            }
+            if self.at >= self.bucket(end) {
+                return None;
+            }
+            self.at += 1;
+            if self.at.is_multiple_of(RING) {
+                let far = std::mem::take(&mut self.far);
+                for event in far.into_iter().filter(&is_current) {
+                    self.push(event);
+                }
+            }
+            // The bucket's events join the heap (empty, or holding the far events that fell in
+            // this very bucket); the bucket keeps its buffer.
+            let mut heap = std::mem::take(&mut self.current).into_vec();
+            let bucket = &mut self.ring[(self.at % RING) as usize];
+            heap.extend(bucket.drain(..).filter(&is_current));
+            self.current = BinaryHeap::from(heap);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (no dependency for one test).
+    fn next(state: &mut u64) -> u64 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        *state >> 33
+    }
+
+    #[test]
+    fn the_calendar_gives_what_one_heap_gives_across_wraps_and_far_events() {
+        // Buckets of 1 ms: the ring spans 4.096 s, and some events lie further off.
+        let mut calendar = Calendar::new(1e-3);
+        let mut heap = BinaryHeap::new();
+        let (mut state, mut now) = (7_u64, 0.0_f64);
+        let mut popped = 0;
+        for step in 0..400 {
+            // New events from now on: most soon, some seconds away (past the ring), some in
+            // the very bucket where the ring next comes round after it (held as far ones).
+            let ring_span = RING as f64 * 1e-3;
+            let round = ((now / ring_span).floor() + 2.0) * ring_span + 0.5e-3;
+            for k in 0..50 {
+                let soon = 0.05 * (next(&mut state) % 1000) as f64 / 1000.0;
+                let time = match k % 10 {
+                    0 => now + 9.0 * soon / 0.05,
+                    1 => round,
+                    _ => now + soon,
+                };
+                let event = Event {
+                    time,
+                    ball: (next(&mut state) % 100) as u32,
+                    other: k,
+                    count: 0,
+                    other_count: 0,
+                };
+                calendar.push(event);
+                heap.push(event);
+            }
+            let end = now + 0.02 + (step % 3) as f64 * 0.01;
+            while let Some(event) = calendar.pop_until(end, |_| true) {
+                assert_eq!(Some(event), heap.pop(), "pop {popped}");
+                popped += 1;
+            }
+            assert!(heap.peek().is_none_or(|event| event.time > end));
+            now = end;
+        }
+        assert!(popped > 15_000, "{popped}");
+    }
+}
