@@ -96,7 +96,10 @@ impl Edmd {
         }
         let count = scene.balls.len();
         let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let cell_size = (2.0 * largest).max(1e-9);
+        // Cells a largest diameter wide, and at most about four per ball (tiny balls in a big
+        // arena make them bigger instead).
+        let area_per_cell = scene.size.x * scene.size.y / (4 * count.max(1)) as f64;
+        let cell_size = (2.0 * largest).max(area_per_cell.sqrt()).max(1e-9);
         let columns = ((scene.size.x / cell_size) as usize).max(1);
         let rows = ((scene.size.y / cell_size) as usize).max(1);
         let cell_size = (scene.size.x / columns as f64).max(scene.size.y / rows as f64);
@@ -143,7 +146,7 @@ impl Edmd {
         for ball in 0..count {
             edmd.predict_walls_and_cells(ball);
             let cells = edmd.neighbourhood(edmd.discs[ball].cell as usize);
-            edmd.predict_pairs_in(ball, cells, f64::INFINITY, true);
+            edmd.predict_pairs_in(ball, cells, true);
         }
         Ok(edmd)
     }
@@ -205,8 +208,9 @@ impl Edmd {
         });
     }
 
-    /// The ball's next wall impact and the moment it leaves its cell, which it returns.
-    fn predict_walls_and_cells(&mut self, ball: usize) -> f64 {
+    /// The ball's next wall impact (if it comes before it leaves its cell: it is predicted
+    /// again from the next one) and the moment it leaves its cell.
+    fn predict_walls_and_cells(&mut self, ball: usize) {
         let (p, v, r) = (
             self.at(ball, self.now),
             self.discs[ball].velocity,
@@ -246,23 +250,19 @@ impl Edmd {
                 }
             }
         }
-        // A wall further off than the cell's edge is predicted again from the next cell.
         if wall.is_finite() && wall <= cross {
             self.schedule(self.now + wall, ball, WALL + wall_axis as u32, 0);
         }
         if cross.is_finite() {
             self.schedule(self.now + cross, ball, CROSS + cross_code as u32, 0);
         }
-        self.now + cross
     }
 
-    /// Every approaching ball in the cells `(columns, rows)` that it meets before `until` (when
-    /// it leaves its cell: it is predicted again then); at the start, each pair once.
+    /// Every approaching ball in the cells `(columns, rows)`; at the start, each pair once.
     fn predict_pairs_in(
         &mut self,
         ball: usize,
         (columns, rows): (std::ops::Range<usize>, std::ops::Range<usize>),
-        until: f64,
         only_later: bool,
     ) {
         let (p, v, r) = (
@@ -293,9 +293,7 @@ impl Edmd {
                         continue;
                     }
                     let t = (c / (-b + discriminant.sqrt())).max(0.0);
-                    if self.now + t <= until {
-                        self.schedule(self.now + t, ball, o as u32, self.discs[o].count);
-                    }
+                    self.schedule(self.now + t, ball, o as u32, self.discs[o].count);
                 }
             }
         }
@@ -309,7 +307,7 @@ impl Edmd {
     fn predict_around(&mut self, ball: usize) {
         self.predict_walls_and_cells(ball);
         let cells = self.neighbourhood(self.discs[ball].cell as usize);
-        self.predict_pairs_in(ball, cells, f64::INFINITY, false);
+        self.predict_pairs_in(ball, cells, false);
     }
 
     fn handle(&mut self, event: Event) {
@@ -340,7 +338,7 @@ impl Edmd {
                 rows = far_side(row, upward, self.rows);
             }
             self.predict_walls_and_cells(ball);
-            self.predict_pairs_in(ball, (columns, rows), f64::INFINITY, false);
+            self.predict_pairs_in(ball, (columns, rows), false);
         } else if event.other >= WALL {
             let axis = (event.other - WALL) as usize;
             self.advance(ball, event.time);
