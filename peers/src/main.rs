@@ -4,6 +4,7 @@
 //! built by `cargo test` or CI: `cargo run --release -p peers -- --scene FILE`.
 
 mod box2d;
+mod calendar;
 mod edmd;
 mod rapier;
 mod scene;
