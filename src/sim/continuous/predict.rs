@@ -84,16 +84,13 @@ impl Timeline {
         }
     }
 
-    /// Every pair's impact, through the grid's candidate pairs, in parallel bands for many
-    /// balls.
+    /// Every pair's impact, through the pairs of swept circles the grid finds touching (the
+    /// swept circles bound the paths: if they do not touch, the balls cannot), in parallel
+    /// bands for many balls.
     fn predict_every_pair(&mut self, dt: f64) {
         let (movers, order) = (&self.movers, &self.order);
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
-            grid.for_each_candidate_pair_in_rows(rows, |i, j, swept_i, swept_j| {
-                // The swept circles bound the paths: if they do not touch, the balls cannot.
-                if !circles_touch(swept_i, swept_j) {
-                    return;
-                }
+            grid.for_each_touching_pair_in_rows(rows, |i, j, _, _| {
                 let (a, b) = (i.min(j), i.max(j));
                 predict_pair((movers, order), (a, b), dt, found);
             });

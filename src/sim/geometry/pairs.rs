@@ -34,7 +34,7 @@ pub fn find_contacts(
         BroadPhase::Grid => {
             grid.rebuild(circles);
             search_in_bands(grid, found, |grid, rows, local| {
-                grid.for_each_candidate_pair_in_rows(rows, keep_touching(local));
+                grid.for_each_touching_pair_in_rows(rows, keep_touching(local));
             });
         }
         BroadPhase::AllPairs => for_each_pair(circles, keep_touching(found)),
@@ -51,10 +51,8 @@ pub fn find_touching_pairs(
 ) {
     grid.rebuild(circles);
     search_in_bands(grid, found, |grid, rows, local| {
-        grid.for_each_candidate_pair_in_rows(rows, |i, j, ci, cj| {
-            if circles_touch(ci, cj) {
-                local.push((i.min(j), i.max(j)));
-            }
+        grid.for_each_touching_pair_in_rows(rows, |i, j, _, _| {
+            local.push((i.min(j), i.max(j)));
         });
     });
 }
@@ -142,7 +140,7 @@ mod tests {
         let mut grid = UniformGrid::default();
         grid.rebuild(&circles);
         let mut sequential = Vec::new();
-        grid.for_each_candidate_pair(keep_touching(&mut sequential));
+        grid.for_each_touching_pair(keep_touching(&mut sequential));
         assert!(sequential.len() > 10_000, "{} contacts", sequential.len());
         assert_eq!(parallel, sequential);
     }

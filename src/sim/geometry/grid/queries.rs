@@ -32,7 +32,7 @@ impl UniformGrid {
 
     /// Calls `visit(index, circle)` for every ball whose circle may touch `circle`: every one
     /// that does, and some that do not. Indices are as in
-    /// [`for_each_candidate_pair`](Self::for_each_candidate_pair).
+    /// [`for_each_touching_pair`](Self::for_each_touching_pair).
     pub fn for_each_that_may_touch(&self, circle: Circle, mut visit: impl FnMut(u32, Circle)) {
         let near = DVec2::splat(circle.radius + self.small_reach);
         self.visit_cells_in_box(circle.center - near, circle.center + near, &mut visit);

@@ -282,7 +282,7 @@ impl UniformGrid {
         self.sorted_index.is_empty()
     }
 
-    /// Rows of cells: the unit [`for_each_candidate_pair_in_rows`](Self::for_each_candidate_pair_in_rows)
+    /// Rows of cells: the unit [`for_each_touching_pair_in_rows`](Self::for_each_touching_pair_in_rows)
     /// splits work by.
     pub fn rows(&self) -> usize {
         self.cells.rows
@@ -294,20 +294,20 @@ impl UniformGrid {
         self.big_limit
     }
 
-    /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls in the same or
-    /// adjacent cells whose circles touch (tested a run at a time, `touching.rs`), and every
-    /// pair with a big ball whose circles' boxes might meet, in a fixed order (the big balls'
-    /// own pairs first, then row by row). Indices are the positions in the slice given to
-    /// [`rebuild`](Self::rebuild).
-    pub fn for_each_candidate_pair(&self, visit: impl FnMut(u32, u32, Circle, Circle)) {
-        self.for_each_candidate_pair_in_rows(0..self.rows(), visit);
+    /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls whose circles
+    /// touch: the candidates, pairs in the same or adjacent cells and pairs with a big ball
+    /// whose circles' boxes might meet, put through the exact test a run at a time
+    /// (`touching.rs`). In a fixed order: the big balls' own pairs first, then row by row.
+    /// Indices are the positions in the slice given to [`rebuild`](Self::rebuild).
+    pub fn for_each_touching_pair(&self, visit: impl FnMut(u32, u32, Circle, Circle)) {
+        self.for_each_touching_pair_in_rows(0..self.rows(), visit);
     }
 
-    /// The pairs [`for_each_candidate_pair`](Self::for_each_candidate_pair) visits from the
+    /// The pairs [`for_each_touching_pair`](Self::for_each_touching_pair) visits from the
     /// cells of `rows`, in the same order (the big balls' own pairs with the first row).
     /// Disjoint row ranges visit disjoint pairs, so bands of rows can be searched in parallel
     /// and their results joined in row order.
-    pub fn for_each_candidate_pair_in_rows(
+    pub fn for_each_touching_pair_in_rows(
         &self,
         rows: std::ops::Range<usize>,
         mut visit: impl FnMut(u32, u32, Circle, Circle),
@@ -364,11 +364,12 @@ impl UniformGrid {
     fn visit_big_pairs(&self, visit: &mut dyn FnMut(u32, u32, Circle, Circle)) {
         if let Some(big) = self.big_grid() {
             let index = |k: u32| self.sorted_index[self.small_count + k as usize];
-            big.for_each_candidate_pair(|i, j, a, b| visit(index(i), index(j), a, b));
+            big.for_each_touching_pair(|i, j, a, b| visit(index(i), index(j), a, b));
         }
     }
 
-    /// Each big ball that reaches `row` with every ball in the cells of `row` it reaches.
+    /// Each big ball that reaches `row` with every ball it touches in the cells of `row` it
+    /// reaches.
     fn visit_big_with_small_in_row(
         &self,
         row: usize,
@@ -379,14 +380,15 @@ impl UniformGrid {
             let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
             let ((first, _), (last, _)) = self.cells.corners_reached(circle, self.small_reach);
             let start = row * self.cells.columns;
-            for other in self.slots_of(start + first..start + last + 1) {
+            let slots = self.slots_of(start + first..start + last + 1);
+            for_each_touching(circle, slots, &self.sorted_circle, |other| {
                 visit(
                     index,
                     self.sorted_index[other],
                     circle,
                     self.sorted_circle[other],
                 );
-            }
+            });
         }
     }
 
@@ -400,6 +402,7 @@ impl UniformGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::geometry::circle::circles_touch;
     use crate::sim::geometry::grid::{for_each_pair, mixed_sizes};
 
     #[test]
@@ -410,14 +413,15 @@ mod tests {
         let mut grid = UniformGrid::default();
         grid.rebuild(&circles);
         let mut seen = std::collections::HashSet::new();
-        grid.for_each_candidate_pair(|i, j, _, _| {
+        grid.for_each_touching_pair(|i, j, a, b| {
             assert_ne!(i, j);
+            assert!(circles_touch(a, b), "({i}, {j}) do not touch");
             assert!(
                 seen.insert((i.min(j), i.max(j))),
                 "pair ({i}, {j}) visited twice"
             );
         });
-        // Every pair within one diameter must be among the candidates.
+        // Every pair within one diameter must be among the pairs visited.
         for_each_pair(&circles, |i, j, a, b| {
             if a.center.distance(b.center) <= a.radius + b.radius {
                 assert!(seen.contains(&(i, j)), "grid missed pair ({i}, {j})");
@@ -429,9 +433,9 @@ mod tests {
     fn grid_survives_empty_single_and_non_finite_input() {
         let mut grid = UniformGrid::default();
         grid.rebuild(&[]);
-        grid.for_each_candidate_pair(|_, _, _, _| panic!("no pairs in an empty grid"));
+        grid.for_each_touching_pair(|_, _, _, _| panic!("no pairs in an empty grid"));
         grid.rebuild(&[Circle::new(DVec2::ZERO, 1.0)]);
-        grid.for_each_candidate_pair(|_, _, _, _| panic!("no pairs with one ball"));
+        grid.for_each_touching_pair(|_, _, _, _| panic!("no pairs with one ball"));
         let strange = [
             Circle::new(DVec2::new(f64::NAN, 0.0), 1.0),
             Circle::new(DVec2::new(f64::INFINITY, 0.0), 1.0),
@@ -439,7 +443,7 @@ mod tests {
         ];
         grid.rebuild(&strange);
         let mut pairs = 0;
-        grid.for_each_candidate_pair(|_, _, _, _| pairs += 1);
+        grid.for_each_touching_pair(|_, _, _, _| pairs += 1);
         assert!(pairs <= 3);
     }
 
@@ -456,7 +460,7 @@ mod tests {
             "and the biggest apart again"
         );
         let mut all = Vec::new();
-        grid.for_each_candidate_pair(|i, j, a, b| {
+        grid.for_each_touching_pair(|i, j, a, b| {
             assert_eq!((a, b), (circles[i as usize], circles[j as usize]));
             all.push((i.min(j), i.max(j)));
         });
@@ -481,7 +485,7 @@ mod tests {
         for bands in [2, 3, 7, rows + 3] {
             let mut joined = Vec::new();
             for band in 0..bands {
-                grid.for_each_candidate_pair_in_rows(
+                grid.for_each_touching_pair_in_rows(
                     rows * band / bands..rows * (band + 1) / bands,
                     |i, j, _, _| {
                         joined.push((i.min(j), i.max(j)));
