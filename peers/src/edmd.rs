@@ -26,6 +26,14 @@ const NONE: u32 = u32::MAX;
 const WALL: u32 = u32::MAX - 8;
 const CROSS: u32 = u32::MAX - 4;
 
+/// The cell holding `point` among `(columns, rows)` cells of side `cell_size` from the origin;
+/// a point past the last ones goes to them.
+fn cell_index(point: DVec2, cell_size: f64, (columns, rows): (usize, usize)) -> usize {
+    let column = ((point.x / cell_size) as usize).min(columns - 1);
+    let row = ((point.y / cell_size) as usize).min(rows - 1);
+    row * columns + column
+}
+
 /// A scheduled event: ball `ball` meets `other` (a ball, or a wall or cell edge, see `WALL`
 /// and `CROSS`) at `time`, if neither has changed since (their counts then).
 #[derive(Clone, Copy, Debug)]
@@ -88,6 +96,7 @@ pub struct Edmd {
     now: f64,
     dt: f64,
     events: Calendar,
+    /// Every ball's place at the end of the last step (at `now`).
     out: Vec<DVec2>,
 }
 
@@ -106,13 +115,8 @@ impl Edmd {
         let rows = ((scene.size.y / cell_size) as usize).max(1);
         let cell_size = (scene.size.x / columns as f64).max(scene.size.y / rows as f64);
         // Numbered in cell order, so that neighbours lie near each other in memory.
-        let cell_of = |b: &Ball| {
-            let column = ((b.position.x / cell_size) as usize).min(columns - 1);
-            let row = ((b.position.y / cell_size) as usize).min(rows - 1);
-            row * columns + column
-        };
         let mut order: Vec<usize> = (0..count).collect();
-        order.sort_by_key(|&k| cell_of(&scene.balls[k]));
+        order.sort_by_key(|&k| cell_index(scene.balls[k].position, cell_size, (columns, rows)));
         let balls: Vec<Ball> = order.iter().map(|&k| scene.balls[k]).collect();
         let mut edmd = Edmd {
             order,
@@ -154,9 +158,7 @@ impl Edmd {
     }
 
     fn cell_at(&self, point: DVec2) -> usize {
-        let column = ((point.x / self.cell_size) as usize).min(self.columns - 1);
-        let row = ((point.y / self.cell_size) as usize).min(self.rows - 1);
-        row * self.columns + column
+        cell_index(point, self.cell_size, (self.columns, self.rows))
     }
 
     fn insert(&mut self, ball: usize, cell: usize) {
@@ -400,7 +402,7 @@ impl Engine for Edmd {
         ];
         for ball in 0..self.out.len() {
             balls[self.order[ball]] = Ball {
-                position: self.at(ball, self.now),
+                position: self.out[ball],
                 velocity: self.discs[ball].velocity,
                 radius: self.discs[ball].radius,
             };
