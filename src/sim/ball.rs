@@ -123,6 +123,9 @@ pub struct BallSnapshot {
     /// Whether the response stopped the ball against a held one, to join the resting
     /// solver at the next step (the continuous mode's impacts on a pile).
     pub stopped: Vec<bool>,
+    /// How many balls were held when the movement stage filled the snapshot, as their
+    /// [`Rest`] said: the count the response's releases do not change.
+    pub held_when_filled: usize,
 }
 
 impl BallSnapshot {
@@ -145,10 +148,12 @@ impl BallSnapshot {
         let mut rest = self.columns_for(count);
         let Ok(tables) = balls.contiguous_iter() else {
             // Not stored in tables: one ball at a time, then all as one piece.
+            let mut held = 0;
             for (entity, position, velocity, radius, rest_state) in balls {
                 let ball = ([entity], [*position], [*velocity], [*radius], [*rest_state]);
-                rest.take_front(1).copy_from(ball);
+                held += rest.take_front(1).copy_from(ball);
             }
+            self.held_when_filled = held;
             let all = (
                 &mut self.circles[..],
                 &mut self.velocities[..],
@@ -165,21 +170,20 @@ impl BallSnapshot {
             let pieces = rest.take_front(len).into_pieces().zip(piece_ranges(len));
             results.extend(in_pieces(pieces, parallel, |(mut into, balls)| {
                 let (entities, positions, velocities, radii, rests) = table;
-                into.copy_from((
+                let held = into.copy_from((
                     &entities[balls.clone()],
                     &positions[balls.clone()],
                     &velocities[balls.clone()],
                     &radii[balls.clone()],
                     &rests[balls.clone()],
                 ));
-                then(
-                    first + balls.start,
-                    (into.circles, into.velocities, into.held),
-                )
+                let piece = (into.circles, into.velocities, into.held);
+                (held, then(first + balls.start, piece))
             }));
             first += len;
         }
-        results
+        self.held_when_filled = results.iter().map(|(held, _)| held).sum();
+        results.into_iter().map(|(_, result)| result).collect()
     }
 
     /// The columns sized for `count` balls (what they held is overwritten; `stopped` is
@@ -227,7 +231,7 @@ impl<'a> Columns<'a> {
         })
     }
 
-    /// Copies in the same number of balls from a table's columns.
+    /// Copies in the same number of balls from a table's columns; returns how many are held.
     fn copy_from(
         &mut self,
         (entities, positions, velocities, radii, rests): (
@@ -237,7 +241,7 @@ impl<'a> Columns<'a> {
             impl AsRef<[Radius]>,
             impl AsRef<[Rest]>,
         ),
-    ) {
+    ) -> usize {
         self.entities.copy_from_slice(entities.as_ref());
         let places = self
             .circles
@@ -250,9 +254,12 @@ impl<'a> Columns<'a> {
         for (velocity, from) in self.velocities.iter_mut().zip(velocities.as_ref()) {
             *velocity = from.0;
         }
+        let mut held_count = 0;
         for (held, rest) in self.held.iter_mut().zip(rests.as_ref()) {
             *held = rest.is_held();
+            held_count += usize::from(*held);
         }
+        held_count
     }
 }
 
@@ -343,6 +350,43 @@ mod tests {
     use bevy::ecs::system::SystemState;
 
     use super::*;
+
+    #[test]
+    fn the_snapshot_counts_the_balls_held_when_it_was_filled() {
+        let mut world = World::new();
+        let held = |k: u32| k % 7 == 3;
+        for k in 0..10_000 {
+            let state = BallState {
+                position: DVec2::new(k as f64, 0.0),
+                velocity: DVec2::X,
+                radius: 1.0,
+            };
+            let rest = Rest {
+                state: if held(k) {
+                    RestState::Resting
+                } else {
+                    RestState::Free
+                },
+                still_for: 0.0,
+            };
+            world.spawn((ball_bundle(BallId(k), state), rest));
+        }
+        let mut state: SystemState<SnapshotBalls> = SystemState::new(&mut world);
+        let balls = state.get(&world).expect("the balls' query");
+        let mut snapshot = BallSnapshot::default();
+        snapshot.fill_then(&balls, |_, _| ());
+        let expected = (0..10_000).filter(|&k| held(k)).count();
+        assert_eq!(snapshot.held_when_filled, expected);
+        assert_eq!(snapshot.held.iter().filter(|&&h| h).count(), expected);
+        // Filled again with nobody held, the count follows.
+        let free = Rest::default();
+        for mut rest in world.query::<&mut Rest>().iter_mut(&mut world) {
+            *rest = free;
+        }
+        let balls = state.get(&world).expect("the balls' query");
+        snapshot.fill_then(&balls, |_, _| ());
+        assert_eq!(snapshot.held_when_filled, 0);
+    }
 
     #[test]
     fn balls_written_back_in_another_order_than_the_query_s_are_found_by_entity() {

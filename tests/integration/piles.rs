@@ -212,7 +212,7 @@ fn sleeping_column(mode: CollisionMode) -> App {
 #[test]
 fn a_sleeping_pile_wakes_at_every_disturbance() {
     type Disturbance = fn(&mut App);
-    let disturbances: [(&str, Disturbance, usize); 9] = [
+    let disturbances: [(&str, Disturbance, usize); 10] = [
         (
             "gravity",
             |app| app.world_mut().resource_mut::<SimParams>().gravity.x = 10.0,
@@ -221,6 +221,12 @@ fn a_sleeping_pile_wakes_at_every_disturbance() {
         (
             "restitution",
             |app| app.world_mut().resource_mut::<SimParams>().restitution = 0.4,
+            0,
+        ),
+        // Elastic: the resting rule is off, so every held ball flies again.
+        (
+            "elastic",
+            |app| app.world_mut().resource_mut::<SimParams>().restitution = 1.0,
             0,
         ),
         (

@@ -86,6 +86,7 @@ pub fn run_timeline(
         velocities,
         held,
         stopped,
+        ..
     } = &mut *snapshot;
     let log = &mut *log;
     let keep_ball_hits = log.keeps_ball_hits();

@@ -113,12 +113,9 @@ pub fn rest_and_sleep(
         mode: solver.collisions,
     };
     let changed = state.last_key.replace(key).is_some_and(|last| last != key);
-    // Read from the components in place, table by table: the elastic gas then never copies a
-    // ball's `Rest`.
-    let anyone_held = match balls.contiguous_iter() {
-        Ok(mut tables) => tables.any(|(.., rests)| rests.iter().any(Rest::is_held)),
-        Err(_) => balls.iter().any(|(.., rest)| rest.is_held()),
-    };
+    // As the components said when the movement stage read them (nothing changes a `Rest`
+    // before this stage): the elastic gas then never reads a ball's `Rest` here.
+    let anyone_held = snapshot.held_when_filled > 0;
     if rest_speed == 0.0 && !anyone_held {
         state.warm.clear();
         return; // the rule is off and nobody rests: the elastic paths stay untouched
