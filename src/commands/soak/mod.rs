@@ -28,7 +28,7 @@ use super::progress::{Progress, print_out};
 use crate::headless::headless_app;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::find_contacts;
+use crate::sim::geometry::pairs::{FoundInBands, find_contacts};
 use crate::sim::measure::summary::{kinetic_energy, potential_energy};
 use crate::sim::params::{
     ARENA_SIDE_RANGE, DAMPING_SLIDER, GRAVITY_SLIDER, RESTITUTION_RANGE, TIME_SCALE_SLIDER,
@@ -171,7 +171,7 @@ fn overlap_allowance(
         return 0.0;
     }
     let circles: Vec<Circle> = balls.iter().map(|&(p, _, r)| Circle::new(p, r)).collect();
-    let mut contacts = Vec::new();
+    let mut contacts = FoundInBands::default();
     find_contacts(
         &circles,
         BroadPhase::Grid,
@@ -187,7 +187,7 @@ fn overlap_allowance(
     let mut islands = Islands::new(balls.len());
     let mut depths = vec![0.0; balls.len()];
     let mut springs = 0.0;
-    for contact in &contacts {
+    for contact in contacts.iter() {
         let depth = contact.geometry.depth;
         islands.join(contact.a, contact.b);
         depths[contact.a as usize] += depth;

@@ -13,7 +13,7 @@ use super::queue::ImpactQueue;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::IndexedContact;
+use crate::sim::geometry::pairs::{FoundInBands, IndexedContact};
 use crate::sim::params::{MassModel, SimParams};
 use crate::sim::resting::rest_speed;
 
@@ -184,7 +184,7 @@ pub struct Timeline {
     pub(super) movers: Vec<Mover>,
     pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.
-    pub(super) fallback: Vec<IndexedContact>,
+    pub(super) fallback: FoundInBands<IndexedContact>,
     /// The balls the search after an impact found, `(which of its two balls, slot)`, before
     /// each is timed (`Timeline::predict_for_both`).
     pub(super) found: Vec<(u8, u32)>,

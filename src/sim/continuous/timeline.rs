@@ -333,7 +333,6 @@ impl Timeline {
         spec: StepSpec,
         on_hit: &mut impl FnMut(Hit),
     ) {
-        self.fallback.clear();
         find_contacts(
             circles,
             BroadPhase::Grid,

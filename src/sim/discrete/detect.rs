@@ -10,14 +10,14 @@ use bevy::prelude::*;
 
 use crate::sim::ball::BallSnapshot;
 use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::geometry::pairs::{FoundInBands, IndexedContact, find_contacts};
 use crate::sim::params::Solver;
 use crate::sim::report::{ContactPoint, StepLog};
 
 /// This step's touching pairs, by their places in the [`BallSnapshot`], in a stable order:
-/// the response handles them in this order.
+/// the response handles them in this order, band after band as the grid's search found them.
 #[derive(Resource, Debug, Default)]
-pub struct Contacts(pub Vec<IndexedContact>);
+pub struct Contacts(pub FoundInBands<IndexedContact>);
 
 /// The grid, kept between steps to reuse its buffers.
 #[derive(Resource, Default)]
@@ -40,7 +40,7 @@ pub fn detect_contacts(
         &mut grid.0,
         &mut contacts.0,
     );
-    for contact in &contacts.0 {
+    for contact in contacts.0.iter() {
         let point = ContactPoint {
             point: contact.geometry.point,
             normal: contact.geometry.normal,

@@ -49,16 +49,14 @@ pub fn resolve_contacts(
     let step_end = clock.dt;
     let log = &mut *log;
     let hits = &mut log.hits;
-    // Each contact's balls marked as it is taken, while they are in the cache.
-    resolve_found_contacts(
-        &contacts.0,
-        &mut in_contact,
-        circles,
-        velocities,
-        held,
-        constants,
-        |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange)),
-    );
+    // Each contact's balls marked as it is taken, while they are in the cache; band after
+    // band, as the search found them.
+    let mut record =
+        |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange));
+    for band in contacts.0.bands() {
+        let arrays = (&mut circles[..], &mut velocities[..], &mut held[..]);
+        resolve_found_contacts(band, &mut in_contact, arrays, constants, &mut record);
+    }
     // Every ball written back (the movement stage moved them in the snapshot only), each piece
     // after the walls again for its balls in a contact: separation may have pushed them into a
     // wall, and only they have moved since the movement stage kept every ball inside.

@@ -115,9 +115,7 @@ pub fn resolve_overlaps(
 pub fn resolve_found_contacts(
     contacts: &[IndexedContact],
     touched: &mut [bool],
-    circles: &mut [Circle],
-    velocities: &mut [DVec2],
-    held: &mut [bool],
+    (circles, velocities, held): (&mut [Circle], &mut [DVec2], &mut [bool]),
     constants: (MassModel, f64, f64),
     on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
@@ -329,7 +327,7 @@ mod tests {
     #[test]
     fn contacts_taken_as_found_resolve_exactly_as_worked_out_again() {
         use crate::sim::geometry::grid::UniformGrid;
-        use crate::sim::geometry::pairs::find_contacts;
+        use crate::sim::geometry::pairs::{FoundInBands, find_contacts};
         use crate::sim::params::BroadPhase;
         // A crowded jumble: most balls in several contacts, so many are moved before their turn.
         let circles: Vec<Circle> = (0..600)
@@ -342,7 +340,7 @@ mod tests {
             .map(|k| DVec2::new((k % 13) as f64 - 6.0, (k % 7) as f64 - 3.0) * 40.0)
             .collect();
         let held: Vec<bool> = (0..600).map(|k| k % 11 == 0).collect();
-        let mut contacts = Vec::new();
+        let mut contacts = FoundInBands::default();
         find_contacts(
             &circles,
             BroadPhase::Grid,
@@ -357,15 +355,11 @@ mod tests {
             let record = |a, b, geometry, exchange| exchanges.push((a, b, geometry, exchange));
             if found {
                 let mut touched = vec![false; 600];
-                resolve_found_contacts(
-                    &contacts,
-                    &mut touched,
-                    &mut c,
-                    &mut v,
-                    &mut h,
-                    constants,
-                    record,
-                );
+                let mut record = record;
+                for band in contacts.bands() {
+                    let arrays = (&mut c[..], &mut v[..], &mut h[..]);
+                    resolve_found_contacts(band, &mut touched, arrays, constants, &mut record);
+                }
             } else {
                 let pairs = contacts.iter().map(|contact| (contact.a, contact.b));
                 resolve_overlaps(pairs, &mut c, &mut v, &mut h, constants, record);

@@ -20,24 +20,75 @@ pub struct IndexedContact {
 /// Bands of rows per thread at work, so an unlucky band does not leave a thread idle.
 const BANDS_PER_THREAD: usize = 4;
 
-/// Finds every touching pair among `circles` and appends it to `found`, each pair once with
-/// `a < b` and the normal from `a` to `b`. The order is fixed by the input and the method,
-/// whatever the number of threads: the grid is searched in bands of rows, in parallel for
-/// large inputs, and the bands' contacts are joined in row order.
+/// Touching pairs as the bands of rows that found them keep them: read band after band
+/// ([`iter`](Self::iter)), they are one list in the order [`find_contacts`] fixes. Kept from
+/// step to step, each band keeps its buffer, so no list is joined or made again once the
+/// sizes settle.
+#[derive(Debug)]
+pub struct FoundInBands<T> {
+    bands: Vec<Vec<T>>,
+}
+
+impl<T> Default for FoundInBands<T> {
+    fn default() -> Self {
+        Self { bands: Vec::new() }
+    }
+}
+
+impl<T> FoundInBands<T> {
+    /// Every pair found, band after band.
+    pub fn iter(&self) -> impl Iterator<Item = &T> + Clone {
+        self.bands.iter().flatten()
+    }
+
+    /// The bands' pairs, band after band.
+    pub fn bands(&self) -> impl Iterator<Item = &[T]> {
+        self.bands.iter().map(Vec::as_slice)
+    }
+
+    /// How many pairs were found.
+    pub fn len(&self) -> usize {
+        self.bands.iter().map(Vec::len).sum()
+    }
+
+    /// Whether no pair was found.
+    pub fn is_empty(&self) -> bool {
+        self.bands.iter().all(Vec::is_empty)
+    }
+
+    /// Empties every band, their buffers kept.
+    pub fn clear(&mut self) {
+        self.bands.iter_mut().for_each(Vec::clear);
+    }
+
+    /// Empties every band and keeps `count` of them (at least one), their buffers kept.
+    fn clear_to(&mut self, count: usize) -> &mut [Vec<T>] {
+        self.bands.truncate(count.max(1));
+        self.clear();
+        self.bands.resize_with(count.max(1), Vec::new);
+        &mut self.bands
+    }
+}
+
+/// Finds every touching pair among `circles` and keeps it in `found` (emptied first), each
+/// pair once with `a < b` and the normal from `a` to `b`. The order is fixed by the input and
+/// the method, whatever the number of threads: the grid is searched in bands of rows, in
+/// parallel for large inputs, and read band after band the pairs are in row order.
 pub fn find_contacts(
     circles: &[Circle],
     method: BroadPhase,
     grid: &mut UniformGrid,
-    found: &mut Vec<IndexedContact>,
+    found: &mut FoundInBands<IndexedContact>,
 ) {
     match method {
         BroadPhase::Grid => {
             grid.rebuild(circles);
-            search_in_bands(grid, found, |grid, rows, local| {
+            let bands = found.clear_to(band_count(grid));
+            search_bands(grid, bands, |grid, rows, local| {
                 grid.for_each_touching_pair_in_rows(rows, keep_touching(local));
             });
         }
-        BroadPhase::AllPairs => for_each_pair(circles, keep_touching(found)),
+        BroadPhase::AllPairs => for_each_pair(circles, keep_touching(&mut found.clear_to(1)[0])),
     }
 }
 
@@ -67,13 +118,11 @@ pub fn search_in_bands<T: Send + 'static>(
     found: &mut Vec<T>,
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
-    let rows = grid.rows();
-    if !worth_splitting(grid.len()) {
-        search(grid, 0..rows, found);
+    let band_count = band_count(grid);
+    if band_count == 1 {
+        search(grid, 0..grid.rows(), found);
         return;
     }
-    let band_count = threads_at_work() * BANDS_PER_THREAD;
-    let search = &search;
     // `found` kept last step's size: each band starts with its share and an eighth more, so
     // the bands' buffers, all alive until joined, are not doubled past what they hold; made
     // here, not on the pool's threads, whose own heaps would keep them after.
@@ -81,15 +130,42 @@ pub fn search_in_bands<T: Send + 'static>(
     let mut bands: Vec<Vec<T>> = (0..band_count)
         .map(|_| Vec::with_capacity(share + share / 8))
         .collect();
-    compute_pool().scope(|scope| {
-        for (band_rows, local) in split_evenly(rows, band_count).zip(&mut bands) {
-            scope.spawn(async move { search(grid, band_rows, local) });
-        }
-    });
+    search_bands(grid, &mut bands, search);
     // Exactly what is needed: the buffer is kept from step to step, and doubling it would
     // leave up to half of it unused (megabytes at a million balls).
     found.reserve_exact(bands.iter().map(Vec::len).sum());
     found.extend(bands.into_iter().flatten());
+}
+
+/// How many bands of rows the grid is searched in: one on one thread or for few balls, else
+/// [`BANDS_PER_THREAD`] for each thread at work.
+fn band_count(grid: &UniformGrid) -> usize {
+    if worth_splitting(grid.len()) {
+        threads_at_work() * BANDS_PER_THREAD
+    } else {
+        1
+    }
+}
+
+/// Runs `search(grid, rows, band)` for each of `bands` over its share of the grid's rows, in
+/// row order, on the compute pool when there is more than one band.
+fn search_bands<T: Send>(
+    grid: &UniformGrid,
+    bands: &mut [Vec<T>],
+    search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
+) {
+    let rows = grid.rows();
+    if let [only] = bands {
+        search(grid, 0..rows, only);
+        return;
+    }
+    let search = &search;
+    let band_rows = split_evenly(rows, bands.len());
+    compute_pool().scope(|scope| {
+        for (band_rows, local) in band_rows.zip(bands) {
+            scope.spawn(async move { search(grid, band_rows, local) });
+        }
+    });
 }
 
 /// A visitor for the broad phase that runs the narrow phase and keeps touching pairs.
@@ -130,7 +206,7 @@ mod tests {
             })
             .collect();
         assert!(circles.len() >= PARALLEL_MIN_BALLS);
-        let mut parallel = Vec::new();
+        let mut parallel = FoundInBands::default();
         find_contacts(
             &circles,
             BroadPhase::Grid,
@@ -142,6 +218,19 @@ mod tests {
         let mut sequential = Vec::new();
         grid.for_each_touching_pair(keep_touching(&mut sequential));
         assert!(sequential.len() > 10_000, "{} contacts", sequential.len());
-        assert_eq!(parallel, sequential);
+        assert_eq!(parallel.iter().copied().collect::<Vec<_>>(), sequential);
+        // Kept for a smaller input, searched in one band, it holds that input's pairs only.
+        let few = &circles[..1000];
+        find_contacts(few, BroadPhase::Grid, &mut grid, &mut parallel);
+        let mut alone = FoundInBands::default();
+        find_contacts(
+            few,
+            BroadPhase::Grid,
+            &mut UniformGrid::default(),
+            &mut alone,
+        );
+        assert!(!alone.is_empty());
+        assert_eq!(parallel.len(), alone.len());
+        assert!(parallel.iter().eq(alone.iter()));
     }
 }

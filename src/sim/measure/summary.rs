@@ -10,7 +10,7 @@ use super::gas::{SPEED_BINS, SpeedHistogram};
 use crate::sim::ball::{Ball, Position, Radius, Rest, Velocity};
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::{IndexedContact, find_contacts};
+use crate::sim::geometry::pairs::{FoundInBands, IndexedContact, find_contacts};
 use crate::sim::params::{BroadPhase, SimParams};
 
 /// Kinetic energy `m v^2 / 2` of one ball.
@@ -122,7 +122,7 @@ pub fn max_overlap_rel(circles: &[Circle]) -> f64 {
 /// The largest overlap among `circles`, and the mean over the overlapping pairs, each
 /// divided by the smaller radius of its pair.
 pub fn overlaps_rel(circles: &[Circle]) -> (f64, f64) {
-    let mut contacts: Vec<IndexedContact> = Vec::new();
+    let mut contacts: FoundInBands<IndexedContact> = FoundInBands::default();
     find_contacts(
         circles,
         BroadPhase::Grid,
