@@ -10,7 +10,7 @@
 use bevy::math::DVec2;
 
 use super::cells::CellMap;
-use super::counting::{NO_CELL, sort_into_cells};
+use super::counting::{NO_CELL, sort_bands, sort_into_cells};
 use super::rows::RowLists;
 use super::touching::for_each_touching;
 use crate::sim::geometry::circle::Circle;
@@ -151,7 +151,7 @@ impl UniformGrid {
                 };
             }
         });
-        let bands = if parallel { threads_at_work() } else { 1 };
+        let bands = sort_bands(count, parallel);
         self.small_count = sort_into_cells(
             &self.cell_of,
             cells.cell_count(),
