@@ -354,8 +354,9 @@ mod tests {
     #[test]
     fn the_snapshot_counts_the_balls_held_when_it_was_filled() {
         let mut world = World::new();
+        // Enough balls for the pool's pieces (`PARALLEL_MIN_BALLS`).
         let held = |k: u32| k % 7 == 3;
-        for k in 0..10_000 {
+        for k in 0..24_000 {
             let state = BallState {
                 position: DVec2::new(k as f64, 0.0),
                 velocity: DVec2::X,
@@ -375,7 +376,7 @@ mod tests {
         let balls = state.get(&world).expect("the balls' query");
         let mut snapshot = BallSnapshot::default();
         snapshot.fill_then(&balls, |_, _| ());
-        let expected = (0..10_000).filter(|&k| held(k)).count();
+        let expected = (0..24_000).filter(|&k| held(k)).count();
         assert_eq!(snapshot.held_when_filled, expected);
         assert_eq!(snapshot.held.iter().filter(|&&h| h).count(), expected);
         // Filled again with nobody held, the count follows.

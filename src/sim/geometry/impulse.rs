@@ -110,7 +110,9 @@ pub fn resolve_overlaps(
 /// [`resolve_overlaps`] for `contacts` as [`find_contacts`](super::pairs::find_contacts) found
 /// them, marking in `touched` the balls of each as it is taken. A contact neither of whose
 /// balls an earlier one touched is still where it was found, so its geometry is used as found:
-/// the same result, without working it out again. For many balls, each contact's balls are
+/// the same result, without working it out again. Contacts found in bands are taken band after
+/// band, one call each, with the same `touched` throughout: a ball an earlier band's contact
+/// moved is worked out again in a later band's. For many balls, each contact's balls are
 /// loaded a few contacts ahead ([`prefetch`]): they lie anywhere in the arrays.
 pub fn resolve_found_contacts(
     contacts: &[IndexedContact],
@@ -212,6 +214,9 @@ pub fn wall_impulse(mass: f64, restitution: f64, normal_speed: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::geometry::grid::UniformGrid;
+    use crate::sim::geometry::pairs::{FoundInBands, find_contacts};
+    use crate::sim::params::BroadPhase;
 
     fn kinetic_energy(velocity: DVec2, inverse_mass: f64) -> f64 {
         0.5 * velocity.length_squared() / inverse_mass
@@ -325,10 +330,39 @@ mod tests {
     }
 
     #[test]
+    fn contacts_found_in_bands_resolve_exactly_as_one_list_worked_out_again() {
+        use crate::sim::parallel::{PARALLEL_MIN_BALLS, threads_at_work};
+        // A crowded lattice, large enough to be searched in bands: a ball's neighbours overlap it,
+        // so contacts across a band's edge move balls another band's contacts take later.
+        let side = 160;
+        let count = side * 150;
+        assert!(count >= PARALLEL_MIN_BALLS);
+        let circles: Vec<Circle> = (0..count)
+            .map(|k| {
+                let (x, y) = ((k % side) as f64 * 4.0, (k / side) as f64 * 4.0);
+                let jitter = ((k * 7919) % 11) as f64 * 0.05;
+                Circle::new(DVec2::new(x + jitter, y - jitter), 2.0 + jitter)
+            })
+            .collect();
+        let velocities = jumbled_velocities(count);
+        let held: Vec<bool> = (0..count).map(|k| k % 17 == 0).collect();
+        let contacts = found_contacts(&circles);
+        if threads_at_work() > 1 {
+            assert!(contacts.bands().count() > 1, "searched in bands");
+        }
+        assert!(contacts.len() > count, "{} contacts", contacts.len());
+        let balls = (&circles[..], &velocities[..], &held[..]);
+        let by_bands = resolved(&contacts, balls, true);
+        assert!(
+            by_bands.3.len() > count / 2,
+            "{} exchanges",
+            by_bands.3.len()
+        );
+        assert!(by_bands == resolved(&contacts, balls, false));
+    }
+
+    #[test]
     fn contacts_taken_as_found_resolve_exactly_as_worked_out_again() {
-        use crate::sim::geometry::grid::UniformGrid;
-        use crate::sim::geometry::pairs::{FoundInBands, find_contacts};
-        use crate::sim::params::BroadPhase;
         // A crowded jumble: most balls in several contacts, so many are moved before their turn.
         let circles: Vec<Circle> = (0..600)
             .map(|k| {
@@ -336,36 +370,54 @@ mod tests {
                 Circle::new(DVec2::new(x, y), 2.0 + (k % 5) as f64 * 0.7)
             })
             .collect();
-        let velocities: Vec<DVec2> = (0..600)
-            .map(|k| DVec2::new((k % 13) as f64 - 6.0, (k % 7) as f64 - 3.0) * 40.0)
-            .collect();
+        let velocities = jumbled_velocities(600);
         let held: Vec<bool> = (0..600).map(|k| k % 11 == 0).collect();
-        let mut contacts = FoundInBands::default();
-        find_contacts(
-            &circles,
-            BroadPhase::Grid,
-            &mut UniformGrid::default(),
-            &mut contacts,
-        );
+        let contacts = found_contacts(&circles);
         assert!(contacts.len() > 500, "{} contacts", contacts.len());
+        let balls = (&circles[..], &velocities[..], &held[..]);
+        assert_eq!(
+            resolved(&contacts, balls, true),
+            resolved(&contacts, balls, false)
+        );
+    }
+
+    fn jumbled_velocities(count: usize) -> Vec<DVec2> {
+        (0..count)
+            .map(|k| DVec2::new((k % 13) as f64 - 6.0, (k % 7) as f64 - 3.0) * 40.0)
+            .collect()
+    }
+
+    /// The touching pairs among `circles`, as the discrete mode's search finds them.
+    fn found_contacts(circles: &[Circle]) -> FoundInBands<IndexedContact> {
+        let mut contacts = FoundInBands::default();
+        let mut grid = UniformGrid::default();
+        find_contacts(circles, BroadPhase::Grid, &mut grid, &mut contacts);
+        contacts
+    }
+
+    /// The balls after `contacts` and each exchange (as text), the contacts taken as found band
+    /// after band (`as_found`) or worked out again as one list.
+    fn resolved(
+        contacts: &FoundInBands<IndexedContact>,
+        (circles, velocities, held): (&[Circle], &[DVec2], &[bool]),
+        as_found: bool,
+    ) -> (Vec<Circle>, Vec<DVec2>, Vec<bool>, Vec<String>) {
         let constants = (MassModel::Radius, 0.8, 5.0);
-        let run = |found: bool| {
-            let (mut c, mut v, mut h) = (circles.clone(), velocities.clone(), held.clone());
-            let mut exchanges = Vec::new();
-            let record = |a, b, geometry, exchange| exchanges.push((a, b, geometry, exchange));
-            if found {
-                let mut touched = vec![false; 600];
-                let mut record = record;
-                for band in contacts.bands() {
-                    let arrays = (&mut c[..], &mut v[..], &mut h[..]);
-                    resolve_found_contacts(band, &mut touched, arrays, constants, &mut record);
-                }
-            } else {
-                let pairs = contacts.iter().map(|contact| (contact.a, contact.b));
-                resolve_overlaps(pairs, &mut c, &mut v, &mut h, constants, record);
-            }
-            (c, v, h, format!("{exchanges:?}"))
+        let (mut c, mut v, mut h) = (circles.to_vec(), velocities.to_vec(), held.to_vec());
+        let mut exchanges = Vec::new();
+        let mut record = |a, b, geometry, exchange: Exchange| {
+            exchanges.push(format!("{a} {b} {geometry:?} {exchange:?}"));
         };
-        assert_eq!(run(true), run(false));
+        if as_found {
+            let mut touched = vec![false; circles.len()];
+            for band in contacts.bands() {
+                let arrays = (&mut c[..], &mut v[..], &mut h[..]);
+                resolve_found_contacts(band, &mut touched, arrays, constants, &mut record);
+            }
+        } else {
+            let pairs = contacts.iter().map(|contact| (contact.a, contact.b));
+            resolve_overlaps(pairs, &mut c, &mut v, &mut h, constants, record);
+        }
+        (c, v, h, exchanges)
     }
 }

@@ -22,8 +22,8 @@ const BANDS_PER_THREAD: usize = 4;
 
 /// Touching pairs as the bands of rows that found them keep them: read band after band
 /// ([`iter`](Self::iter)), they are one list in the order [`find_contacts`] fixes. Kept from
-/// step to step, each band keeps its buffer, so no list is joined or made again once the
-/// sizes settle.
+/// step to step, each band keeps its buffer, so no list is joined, and none is made again
+/// while the number of bands and the pairs' count stay about the same.
 #[derive(Debug)]
 pub struct FoundInBands<T> {
     bands: Vec<Vec<T>>,

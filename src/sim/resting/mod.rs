@@ -114,7 +114,7 @@ pub fn rest_and_sleep(
     };
     let changed = state.last_key.replace(key).is_some_and(|last| last != key);
     // As the components said when the movement stage read them (nothing changes a `Rest`
-    // before this stage): the elastic gas then never reads a ball's `Rest` here.
+    // between that stage and this one): the elastic gas then never reads a ball's `Rest` here.
     let anyone_held = snapshot.held_when_filled > 0;
     if rest_speed == 0.0 && !anyone_held {
         state.warm.clear();

@@ -14,9 +14,9 @@ pub const NO_CELL: u32 = u32::MAX;
 /// Below this many balls the sort is one band, threads or not: every band reads every ball,
 /// and while the buffers fit in a core's cache one band is faster than two (the standard gas
 /// on this project's two cores, ms a step for the sort, one band against two: 0.32 against
-/// 0.45–0.56 at 100,000 balls, 0.70 against 0.73–0.93 at 200,000, 1.9–2.2 against 1.5 at
-/// 400,000).
-const BANDED_SORT_MIN_BALLS: usize = 200_000;
+/// 0.45–0.56 at 100,000 balls, 0.70–0.71 against 0.73–0.93 at 200,000, 1.35–1.71 against
+/// 1.19–1.46 at 300,000, 1.86–2.15 against 1.46–1.54 at 400,000).
+const BANDED_SORT_MIN_BALLS: usize = 250_000;
 
 /// The bands of cells to sort `balls` balls in when the work is split (`parallel`) or not:
 /// one for each thread at work from [`BANDED_SORT_MIN_BALLS`] balls, else one.
