@@ -160,9 +160,15 @@ impl StepLog {
 
     /// Counts a contact point, and keeps it if this step's [`HitReports`] asks for them.
     pub fn note_contact(&mut self, contact: ContactPoint) {
-        self.contact_count += 1;
+        self.note_contacts(1, [contact]);
+    }
+
+    /// Counts `count` contact points, and keeps `points`, the same ones, if this step's
+    /// [`HitReports`] asks for them: a step that drops them never reads them.
+    pub fn note_contacts(&mut self, count: u64, points: impl IntoIterator<Item = ContactPoint>) {
+        self.contact_count += count;
         if !self.drop_contacts {
-            self.contacts.push(contact);
+            self.contacts.extend(points);
         }
     }
 }

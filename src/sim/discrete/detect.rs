@@ -40,11 +40,9 @@ pub fn detect_contacts(
         &mut grid.0,
         &mut contacts.0,
     );
-    for contact in contacts.0.iter() {
-        let point = ContactPoint {
-            point: contact.geometry.point,
-            normal: contact.geometry.normal,
-        };
-        log.note_contact(point);
-    }
+    let points = contacts.0.iter().map(|contact| ContactPoint {
+        point: contact.geometry.point,
+        normal: contact.geometry.normal,
+    });
+    log.note_contacts(contacts.0.len() as u64, points);
 }
