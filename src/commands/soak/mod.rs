@@ -27,16 +27,15 @@ use rand_chacha::ChaCha8Rng;
 use super::progress::{Progress, print_out};
 use crate::headless::headless_app;
 use crate::sim::geometry::Circle;
-use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::{FoundInBands, find_contacts};
+use crate::sim::geometry::pairs::contacts_among;
 use crate::sim::measure::summary::{kinetic_energy, potential_energy};
 use crate::sim::params::{
     ARENA_SIDE_RANGE, DAMPING_SLIDER, GRAVITY_SLIDER, RESTITUTION_RANGE, TIME_SCALE_SLIDER,
 };
 use crate::sim::resting::{Islands, contact_hertz};
 use crate::sim::{
-    Ball, BroadPhase, CollisionMode, Position, Radius, Rest, RunControl, SceneSetup, SimParams,
-    Solver, Velocity,
+    Ball, CollisionMode, Position, Radius, Rest, RunControl, SceneSetup, SimParams, Solver,
+    Velocity,
 };
 
 /// Steps between the simulated player's actions, on average.
@@ -171,13 +170,7 @@ fn overlap_allowance(
         return 0.0;
     }
     let circles: Vec<Circle> = balls.iter().map(|&(p, _, r)| Circle::new(p, r)).collect();
-    let mut contacts = FoundInBands::default();
-    find_contacts(
-        &circles,
-        BroadPhase::Grid,
-        &mut UniformGrid::default(),
-        &mut contacts,
-    );
+    let contacts = contacts_among(&circles);
     let omega = 2.0 * std::f64::consts::PI * contact_hertz(dt);
     let awake_mass = |ball: u32| match asleep.get(ball as usize) {
         Some(true) => 0.0,

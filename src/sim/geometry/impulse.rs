@@ -214,9 +214,7 @@ pub fn wall_impulse(mass: f64, restitution: f64, normal_speed: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::geometry::grid::UniformGrid;
-    use crate::sim::geometry::pairs::{FoundInBands, find_contacts};
-    use crate::sim::params::BroadPhase;
+    use crate::sim::geometry::pairs::{FoundInBands, contacts_among};
 
     fn kinetic_energy(velocity: DVec2, inverse_mass: f64) -> f64 {
         0.5 * velocity.length_squared() / inverse_mass
@@ -346,7 +344,7 @@ mod tests {
             .collect();
         let velocities = jumbled_velocities(count);
         let held: Vec<bool> = (0..count).map(|k| k % 17 == 0).collect();
-        let contacts = found_contacts(&circles);
+        let contacts = contacts_among(&circles);
         if threads_at_work() > 1 {
             assert!(contacts.bands().count() > 1, "searched in bands");
         }
@@ -372,7 +370,7 @@ mod tests {
             .collect();
         let velocities = jumbled_velocities(600);
         let held: Vec<bool> = (0..600).map(|k| k % 11 == 0).collect();
-        let contacts = found_contacts(&circles);
+        let contacts = contacts_among(&circles);
         assert!(contacts.len() > 500, "{} contacts", contacts.len());
         let balls = (&circles[..], &velocities[..], &held[..]);
         assert_eq!(
@@ -385,14 +383,6 @@ mod tests {
         (0..count)
             .map(|k| DVec2::new((k % 13) as f64 - 6.0, (k % 7) as f64 - 3.0) * 40.0)
             .collect()
-    }
-
-    /// The touching pairs among `circles`, as the discrete mode's search finds them.
-    fn found_contacts(circles: &[Circle]) -> FoundInBands<IndexedContact> {
-        let mut contacts = FoundInBands::default();
-        let mut grid = UniformGrid::default();
-        find_contacts(circles, BroadPhase::Grid, &mut grid, &mut contacts);
-        contacts
     }
 
     /// The balls after `contacts` and each exchange (as text), the contacts taken as found band

@@ -92,6 +92,19 @@ pub fn find_contacts(
     }
 }
 
+/// Every touching pair among `circles`, as [`find_contacts`] finds them with the grid, searched
+/// with a grid of its own: for a measurement made once, not a stage's every step.
+pub fn contacts_among(circles: &[Circle]) -> FoundInBands<IndexedContact> {
+    let mut found = FoundInBands::default();
+    find_contacts(
+        circles,
+        BroadPhase::Grid,
+        &mut UniformGrid::default(),
+        &mut found,
+    );
+    found
+}
+
 /// Appends to `found` every touching pair among `circles` as `(a, b)`, `a < b`: the pairs
 /// [`find_contacts`] finds with the grid, in its order, without their geometry (for callers
 /// that measure the pairs themselves).

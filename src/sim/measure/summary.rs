@@ -9,9 +9,8 @@ use bevy::prelude::*;
 use super::gas::{SPEED_BINS, SpeedHistogram};
 use crate::sim::ball::{Ball, Position, Radius, Rest, Velocity};
 use crate::sim::geometry::Circle;
-use crate::sim::geometry::grid::UniformGrid;
-use crate::sim::geometry::pairs::{FoundInBands, IndexedContact, find_contacts};
-use crate::sim::params::{BroadPhase, SimParams};
+use crate::sim::geometry::pairs::contacts_among;
+use crate::sim::params::SimParams;
 
 /// Kinetic energy `m v^2 / 2` of one ball.
 #[inline]
@@ -122,13 +121,7 @@ pub fn max_overlap_rel(circles: &[Circle]) -> f64 {
 /// The largest overlap among `circles`, and the mean over the overlapping pairs, each
 /// divided by the smaller radius of its pair.
 pub fn overlaps_rel(circles: &[Circle]) -> (f64, f64) {
-    let mut contacts: FoundInBands<IndexedContact> = FoundInBands::default();
-    find_contacts(
-        circles,
-        BroadPhase::Grid,
-        &mut UniformGrid::default(),
-        &mut contacts,
-    );
+    let contacts = contacts_among(circles);
     let (mut largest, mut sum, mut count) = (0.0_f64, 0.0, 0_usize);
     for contact in contacts.iter().filter(|c| c.geometry.depth > 0.0) {
         let smaller = circles[contact.a as usize]
