@@ -25,7 +25,7 @@ use bevy::prelude::*;
 use super::ball::{Ball, BallSnapshot, Position, PreviousPosition, SnapshotBalls};
 use super::clock::SimClock;
 use super::geometry::Circle;
-use super::geometry::contain::{Contained, contain_piece};
+use super::geometry::contain::{Contained, contain_in_place, contain_piece};
 use super::params::{MassModel, SimParams};
 use super::report::{StepLog, record_walls_met};
 use super::resting::rest_speed;
@@ -132,12 +132,14 @@ impl Arena {
         chosen: impl Fn(usize) -> bool,
         motion: Option<Motion>,
     ) -> Vec<(u32, Contained)> {
-        let moved = |center, velocity| match motion {
-            Some(motion) => motion.integrate(center, velocity),
-            None => (center, velocity),
-        };
         let arena = (self.half, self.restitution, self.rest_speed);
-        contain_piece(first, balls, &chosen, &moved, arena)
+        match motion {
+            Some(motion) => {
+                let moved = |center, velocity| motion.integrate(center, velocity);
+                contain_piece(first, balls, &chosen, &moved, arena)
+            }
+            None => contain_in_place(first, balls, &chosen, arena),
+        }
     }
 
     /// Records in `log` the wall hits and resting impulses of the balls in `met`, in the
