@@ -123,6 +123,26 @@ fn place(
     }
 }
 
+/// Each slot's cell into `slots`, the slots of the consecutive `cells` (cell `c` holds the
+/// slots `starts[c]..starts[c + 1]`). Without a branch on each cell's count, which is 0 to 3
+/// balls at random: each cell writes its number at its first slot, in order, so the cell that
+/// holds the balls there writes last; then each slot takes the highest number written up to
+/// it.
+pub fn cells_of_slots(starts: &[u32], cells: Range<usize>, slots: &mut [u32]) {
+    let first = starts[cells.start] as usize;
+    slots.fill(0);
+    for cell in cells {
+        if let Some(head) = slots.get_mut(starts[cell] as usize - first) {
+            *head = cell as u32;
+        }
+    }
+    let mut cell = 0;
+    for slot in slots.iter_mut() {
+        cell = cell.max(*slot);
+        *slot = cell;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,6 +152,32 @@ mod tests {
         assert_eq!(sort_bands(BANDED_SORT_MIN_BALLS - 1, true), 1);
         assert_eq!(sort_bands(BANDED_SORT_MIN_BALLS, false), 1);
         assert_eq!(sort_bands(BANDED_SORT_MIN_BALLS, true), threads_at_work());
+    }
+
+    #[test]
+    fn each_slot_gets_its_cell_however_many_cells_are_empty() {
+        // Cells holding 0 to 3 balls, empty ones first, last and in runs.
+        let count = |c: u32| {
+            if c >= 495 {
+                0
+            } else {
+                [0, 1, 0, 0, 2, 3, 1, 0][(c * 7 % 8) as usize]
+            }
+        };
+        let counts: Vec<u32> = (0..500).map(count).collect();
+        let mut starts = vec![0];
+        for count in &counts {
+            starts.push(starts.last().unwrap() + count);
+        }
+        let expected: Vec<u32> = (0..500_u32)
+            .flat_map(|c| std::iter::repeat_n(c, counts[c as usize] as usize))
+            .collect();
+        for cells in [0..500, 0..2, 3..4, 0..37, 37..500, 490..500, 5..480] {
+            let slots = starts[cells.start] as usize..starts[cells.end] as usize;
+            let mut found = vec![NO_CELL; slots.len()];
+            cells_of_slots(&starts, cells.clone(), &mut found);
+            assert_eq!(found, expected[slots], "cells {cells:?}");
+        }
     }
 
     #[test]

@@ -10,7 +10,7 @@
 use bevy::math::DVec2;
 
 use super::cells::CellMap;
-use super::counting::{NO_CELL, sort_bands, sort_into_cells};
+use super::counting::{NO_CELL, cells_of_slots, sort_bands, sort_into_cells};
 use super::rows::RowLists;
 use super::touching::for_each_touching;
 use crate::sim::geometry::circle::Circle;
@@ -217,11 +217,7 @@ impl UniformGrid {
             .map(|cells| starts[cells.start] as usize..starts[cells.end] as usize);
         let work = band_cells.zip(carve(&mut self.cell_of, band_slots));
         in_pieces(work, parallel, |(cells, slots)| {
-            let first = starts[cells.start] as usize;
-            for cell in cells {
-                let (start, end) = (starts[cell] as usize, starts[cell + 1] as usize);
-                slots[start - first..end - first].fill(cell as u32);
-            }
+            cells_of_slots(starts, cells, slots)
         });
         self.cell_of[self.small_count..].fill(NO_CELL);
     }
