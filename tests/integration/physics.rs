@@ -8,7 +8,7 @@
 use ballpit::prelude::*;
 use ballpit::sim::geometry::Circle;
 use ballpit::sim::geometry::grid::UniformGrid;
-use ballpit::sim::geometry::pairs::{FoundInBands, IndexedContact, find_contacts};
+use ballpit::sim::geometry::pairs::{FoundInBands, IndexedContact, contacts_among, find_contacts};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use rand::{RngExt, SeedableRng};
@@ -445,13 +445,7 @@ fn grid_and_all_pairs_find_exactly_the_same_contacts() {
                 Circle::new(center, rng.random_range(0.5..25.0))
             })
             .collect();
-        let (mut by_grid, mut by_all_pairs) = (FoundInBands::default(), FoundInBands::default());
-        find_contacts(
-            &circles,
-            BroadPhase::Grid,
-            &mut UniformGrid::default(),
-            &mut by_grid,
-        );
+        let (by_grid, mut by_all_pairs) = (contacts_among(&circles), FoundInBands::default());
         find_contacts(
             &circles,
             BroadPhase::AllPairs,

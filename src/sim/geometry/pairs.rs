@@ -219,13 +219,7 @@ mod tests {
             })
             .collect();
         assert!(circles.len() >= PARALLEL_MIN_BALLS);
-        let mut parallel = FoundInBands::default();
-        find_contacts(
-            &circles,
-            BroadPhase::Grid,
-            &mut UniformGrid::default(),
-            &mut parallel,
-        );
+        let mut parallel = contacts_among(&circles);
         let mut grid = UniformGrid::default();
         grid.rebuild(&circles);
         let mut sequential = Vec::new();
@@ -235,13 +229,7 @@ mod tests {
         // Kept for a smaller input, searched in one band, it holds that input's pairs only.
         let few = &circles[..1000];
         find_contacts(few, BroadPhase::Grid, &mut grid, &mut parallel);
-        let mut alone = FoundInBands::default();
-        find_contacts(
-            few,
-            BroadPhase::Grid,
-            &mut UniformGrid::default(),
-            &mut alone,
-        );
+        let alone = contacts_among(few);
         assert!(!alone.is_empty());
         assert_eq!(parallel.len(), alone.len());
         assert!(parallel.iter().eq(alone.iter()));
