@@ -5,7 +5,8 @@
 
 /// Below this many balls the arrays a step reads mostly fit the cache, and loading ahead only
 /// costs: measured for both users, 1–3% at 1,000 and 10,000 balls (four rounds each), where
-/// from 30,000 on the continuous timeline gains (README, *Prefetching the coming impacts*).
+/// from 30,000 on the continuous timeline gains (docs/performance.md, *Prefetching the coming
+/// impacts*).
 pub const PREFETCH_MIN_BALLS: usize = 20_000;
 
 /// Starts bringing the cache line that holds `place` into every level of the cache, without

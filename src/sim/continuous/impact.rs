@@ -45,7 +45,8 @@ pub fn wall_code(wall: Wall) -> u32 {
 /// by slot (their place in the grid's cell order); `indices` holds the same balls' indices in
 /// the step's input, by which impacts at the same time are ordered, as they were before the
 /// timeline knew slots. (A pile's history depends on that order; any order settles the
-/// 10,000-ball piles as often over many seeds: README, *Balls are stored in space order*.)
+/// 10,000-ball piles as often over many seeds: docs/performance.md, *Balls are stored in space
+/// order*.)
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Impact {
     /// Seconds into the step.

@@ -1,7 +1,7 @@
 //! Stage 3's loads ahead, continuous: what the impacts about to be taken will read, brought
 //! into the cache before they read it. Impacts come in time order, so each one's balls lie
 //! anywhere in memory, and at a million balls waiting for those reads is most of an impact's
-//! cost (README, *Prefetching the coming impacts*). The timeline's loop calls
+//! cost (docs/performance.md, *Prefetching the coming impacts*). The timeline's loop calls
 //! [`Timeline::prefetch_coming`] before each impact; nothing here changes a result.
 
 use super::impact::Impact;
@@ -23,10 +23,11 @@ impl Timeline {
 
     /// Loads what the impacts about to be taken will read, so that it is in the cache when
     /// they are: impacts come in time order, so each one's balls lie anywhere in memory, and
-    /// at a million balls waiting for those reads is most of an impact's cost (README,
-    /// *Prefetching the coming impacts*). For the step's first predictions a few places
-    /// ahead, the balls first and, nearer, the cells around the first ball (which need its
-    /// cell, loaded with the balls); for the earliest impact predicted since, all at once.
+    /// at a million balls waiting for those reads is most of an impact's cost
+    /// (docs/performance.md, *Prefetching the coming impacts*). For the step's first
+    /// predictions a few places ahead, the balls first and, nearer, the cells around the first
+    /// ball (which need its cell, loaded with the balls); for the earliest impact predicted
+    /// since, all at once.
     /// Nothing here changes a result.
     pub(super) fn prefetch_coming(&self) {
         if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
