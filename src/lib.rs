@@ -6,7 +6,8 @@
 //! - [`headless`]: apps with only the simulation, one fixed step per update; the timing loop.
 //! - [`commands`]: `run` (a scene stepped and reported), `bench` (the standard gas timed at
 //!   several sizes), `soak` (random scenes run long with checks after every step).
-//! - [`cli`]: the `ballpit` command line.
+//! - [`cli`]: the `ballpit` command line; [`huge_pages`]: the binary started again with the
+//!   heap on huge pages (Linux with glibc), before anything else runs.
 //!
 //! The toy (the default `gui` feature: window, rendering, egui):
 //! - `app`: the toy's shared state (scene requests, view settings);
@@ -17,6 +18,7 @@
 pub mod cli;
 pub mod commands;
 pub mod headless;
+pub mod huge_pages;
 pub mod sim;
 
 #[cfg(feature = "gui")]

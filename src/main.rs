@@ -5,5 +5,8 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
+    // First, while nothing has run: on Linux with glibc this starts the binary again with its
+    // heap on huge pages, and does not return (see `huge_pages`).
+    ballpit::huge_pages::rerun_with_huge_pages();
     ballpit::cli::Cli::parse().run()
 }
