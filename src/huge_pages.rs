@@ -10,7 +10,9 @@
 //! before a process starts, and setting it from safe code means starting the process again.
 //! Nothing here changes a result. The user's own choice wins: a `GLIBC_TUNABLES` that already
 //! names `glibc.malloc.hugetlb` (`=0` turns it off) is left alone, and if the binary cannot be
-//! started again it runs on as it is.
+//! started again it runs on as it is. Under valgrind it is not started again either: valgrind
+//! follows a new program only when told to (`--trace-children=yes`), so the run would escape
+//! it, and callgrind's counts with it.
 
 use std::ffi::{OsStr, OsString};
 
@@ -34,13 +36,23 @@ pub fn tunables_with_huge_pages(current: Option<&OsStr>) -> Option<OsString> {
     (!named).then(|| format!("{current}:{asked}").into())
 }
 
+/// Whether the preloaded libraries (`LD_PRELOAD`) are valgrind's, which it gives every
+/// program it runs (`vgpreload_core-amd64-linux.so` and the tool's own).
+pub fn under_valgrind(preloaded: Option<&OsStr>) -> bool {
+    preloaded.is_some_and(|preloaded| preloaded.to_string_lossy().contains("vgpreload"))
+}
+
 /// Starts this binary again, with the same arguments, with huge pages asked for (see the
-/// header); returns only if they are already asked for or refused, or the start failed.
+/// header); returns only if they are already asked for or refused, under valgrind, or if the
+/// start failed.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 pub fn rerun_with_huge_pages() {
     use std::os::unix::process::CommandExt;
     use std::process::Command;
 
+    if under_valgrind(std::env::var_os("LD_PRELOAD").as_deref()) {
+        return;
+    }
     let Some(tunables) = tunables_with_huge_pages(std::env::var_os(TUNABLES).as_deref()) else {
         return;
     };
@@ -89,6 +101,18 @@ mod tests {
             with(Some("glibc.malloc.hugetlbx=1")).as_deref(),
             Some("glibc.malloc.hugetlbx=1:glibc.malloc.hugetlb=1")
         );
+    }
+
+    #[test]
+    fn valgrind_is_known_by_its_preloaded_libraries() {
+        let preloaded = |value: &str| under_valgrind(Some(OsStr::new(value)));
+        assert!(preloaded(
+            "/usr/libexec/valgrind/vgpreload_core-amd64-linux.so:\
+             /usr/libexec/valgrind/vgpreload_memcheck-amd64-linux.so"
+        ));
+        assert!(!preloaded("/usr/lib/x86_64-linux-gnu/libjemalloc.so.2"));
+        assert!(!preloaded(""));
+        assert!(!under_valgrind(None));
     }
 
     #[cfg(unix)]
