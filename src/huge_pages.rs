@@ -37,8 +37,8 @@ pub fn tunables_with_huge_pages(current: Option<&OsStr>) -> Option<OsString> {
     let Some(current) = current.filter(|current| !current.is_empty()) else {
         return Some(asked.into());
     };
+    let current = current.to_str()?;
     let pairs: Vec<(&str, &str)> = current
-        .to_str()?
         .split(':')
         .map(|pair| pair.split_once('='))
         .collect::<Option<_>>()?;
@@ -46,7 +46,7 @@ pub fn tunables_with_huge_pages(current: Option<&OsStr>) -> Option<OsString> {
         .iter()
         .all(|(name, value)| !name.is_empty() && !value.contains('='));
     let named = pairs.iter().any(|&(name, _)| name == HUGE_PAGES);
-    (well_formed && !named).then(|| format!("{}:{asked}", current.to_string_lossy()).into())
+    (well_formed && !named).then(|| format!("{current}:{asked}").into())
 }
 
 /// The `GLIBC_TUNABLES` to start again with, given the environment's [`RESTARTED`],

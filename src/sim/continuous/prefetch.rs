@@ -27,8 +27,7 @@ impl Timeline {
     /// (docs/performance.md, *Prefetching the coming impacts*). For the step's first
     /// predictions a few places ahead, the balls first and, nearer, the cells around the first
     /// ball (which need its cell, loaded with the balls); for the earliest impact predicted
-    /// since, all at once.
-    /// Nothing here changes a result.
+    /// since, all at once. Nothing here changes a result.
     pub(super) fn prefetch_coming(&self) {
         if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
             self.prefetch_balls(further);
