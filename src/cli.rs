@@ -108,6 +108,10 @@ pub struct BenchArgs {
     /// Run the all-pairs reference for sizes up to this (it is O(N^2)).
     #[arg(long, default_value_t = 10_000)]
     pub all_pairs_max: u64,
+    /// Rounds of the gas's cases, each round every case once; each case reports its median
+    /// round (a single run moves by up to 10% on a busy machine).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=100))]
+    pub rounds: u64,
     /// Print the rows as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -358,40 +362,26 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     if args.mixed {
         return run_mixed_bench(&args);
     }
-    let mut rows = Vec::new();
     let sizes = args.sizes.clone().unwrap_or(vec![1_000, 10_000, 100_000]);
     let steps = args.steps.unwrap_or(200);
-    let progress = Progress::new(sizes.len() as u64, "sizes", args.quiet || args.json);
-    for balls in sizes {
-        let balls = balls as usize;
-        let discrete = BenchCase {
-            balls,
-            steps,
-            broad_phase: BroadPhase::Grid,
-            collisions: CollisionMode::Discrete,
-        };
-        let all_pairs = (balls as u64 <= args.all_pairs_max).then_some(BenchCase {
-            steps: (steps / 10).max(5),
-            broad_phase: BroadPhase::AllPairs,
-            ..discrete
-        });
-        let continuous = BenchCase {
-            collisions: CollisionMode::Continuous,
-            ..discrete
-        };
-        let row = BenchRow {
-            balls,
-            one_core: run_case_in_child(discrete, true)?,
-            all_cores: run_case_in_child(discrete, false)?,
-            all_pairs: all_pairs
-                .map(|case| run_case_in_child(case, true))
-                .transpose()?,
-            continuous_one_core: run_case_in_child(continuous, true)?,
-            continuous_all_cores: run_case_in_child(continuous, false)?,
-        };
-        rows.push(row);
-        progress.advance(1);
+    let rounds = args.rounds as usize;
+    let progress = Progress::new(
+        (rounds * sizes.len()) as u64,
+        "sizes (every round)",
+        args.quiet || args.json,
+    );
+    // Round after round, each size's cases once in each.
+    let mut by_size: Vec<Vec<BenchRow>> = vec![Vec::new(); sizes.len()];
+    for _ in 0..rounds {
+        for (&balls, rows) in sizes.iter().zip(&mut by_size) {
+            rows.push(bench_row(balls as usize, steps, args.all_pairs_max)?);
+            progress.advance(1);
+        }
     }
+    let rows: Vec<BenchRow> = by_size
+        .into_iter()
+        .filter_map(BenchRow::median_of_rounds)
+        .collect();
     drop(progress);
     if args.json {
         print_out(&format!("{}\n", serde_json::to_string(&rows)?))?;
@@ -399,6 +389,35 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         print_out(&format_table(&rows))?;
     }
     Ok(())
+}
+
+/// One size's bench cases, each once, in its own child process.
+fn bench_row(balls: usize, steps: u64, all_pairs_max: u64) -> Result<BenchRow, Box<dyn Error>> {
+    let discrete = BenchCase {
+        balls,
+        steps,
+        broad_phase: BroadPhase::Grid,
+        collisions: CollisionMode::Discrete,
+    };
+    let all_pairs = (balls as u64 <= all_pairs_max).then_some(BenchCase {
+        steps: (steps / 10).max(5),
+        broad_phase: BroadPhase::AllPairs,
+        ..discrete
+    });
+    let continuous = BenchCase {
+        collisions: CollisionMode::Continuous,
+        ..discrete
+    };
+    Ok(BenchRow {
+        balls,
+        one_core: run_case_in_child(discrete, true)?,
+        all_cores: run_case_in_child(discrete, false)?,
+        all_pairs: all_pairs
+            .map(|case| run_case_in_child(case, true))
+            .transpose()?,
+        continuous_one_core: run_case_in_child(continuous, true)?,
+        continuous_all_cores: run_case_in_child(continuous, false)?,
+    })
 }
 
 fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {

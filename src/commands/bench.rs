@@ -5,7 +5,10 @@
 //!
 //! Each case runs in a child process (`ballpit bench-one`), so its peak memory is its own and
 //! its core count can be set: one-core cases are started under `taskset -c 0`, which Bevy's
-//! task pools see as one available core. Timings are compared as ratios within one run.
+//! task pools see as one available core. Timings are compared as ratios within one run, and
+//! every case runs in several rounds, each round every case once, so that a slow spell of the
+//! machine falls on all of them alike; each case reports its median round
+//! ([`BenchRow::median_of_rounds`]).
 
 use std::error::Error;
 use std::process::Command;
@@ -58,6 +61,31 @@ pub struct CaseResult {
     pub collisions_per_cpu_second: f64,
     /// Peak resident memory of the process, MiB (Linux only).
     pub peak_rss_mib: Option<f64>,
+    /// In `bench`, each round's `ms_per_step_median`, in the order run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rounds_ms_per_step: Vec<f64>,
+}
+
+impl CaseResult {
+    /// The round whose step's median is the median of `rounds`' (the faster of the middle two
+    /// for an even count), with every round's and the highest peak RSS of them all. `None`
+    /// without rounds.
+    pub fn median_round(rounds: Vec<CaseResult>) -> Option<CaseResult> {
+        let in_order: Vec<f64> = rounds.iter().map(|r| r.ms_per_step_median).collect();
+        let peak_rss_mib = rounds
+            .iter()
+            .filter_map(|r| r.peak_rss_mib)
+            .reduce(f64::max);
+        let mut sorted = rounds;
+        sorted.sort_by(|a, b| a.ms_per_step_median.total_cmp(&b.ms_per_step_median));
+        let middle = sorted.len().checked_sub(1)? / 2;
+        let median = sorted.swap_remove(middle);
+        Some(CaseResult {
+            peak_rss_mib,
+            rounds_ms_per_step: in_order,
+            ..median
+        })
+    }
 }
 
 /// Runs `case` in this process with `threads` threads at work on each step.
@@ -95,6 +123,7 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
         collisions_per_sim_second: collisions / (steps * DEFAULT_DT),
         collisions_per_cpu_second: collisions / (total_ms.max(f64::MIN_POSITIVE) * 1e-3),
         peak_rss_mib: peak_rss_mib(),
+        rounds_ms_per_step: Vec::new(),
     })
 }
 
@@ -174,6 +203,27 @@ pub struct BenchRow {
 }
 
 impl BenchRow {
+    /// One size's rows from several rounds as one: each case its [median
+    /// round](CaseResult::median_round). `None` without rounds.
+    pub fn median_of_rounds(rounds: Vec<BenchRow>) -> Option<BenchRow> {
+        let balls = rounds.first()?.balls;
+        let median = |case: fn(&BenchRow) -> &CaseResult| {
+            CaseResult::median_round(rounds.iter().map(|row| case(row).clone()).collect())
+        };
+        let all_pairs = rounds
+            .iter()
+            .filter_map(|row| row.all_pairs.clone())
+            .collect();
+        Some(BenchRow {
+            balls,
+            one_core: median(|row| &row.one_core)?,
+            all_cores: median(|row| &row.all_cores)?,
+            all_pairs: CaseResult::median_round(all_pairs),
+            continuous_one_core: median(|row| &row.continuous_one_core)?,
+            continuous_all_cores: median(|row| &row.continuous_all_cores)?,
+        })
+    }
+
     pub fn speedup_over_all_pairs(&self) -> Option<f64> {
         self.all_pairs
             .as_ref()
@@ -214,8 +264,16 @@ pub fn cost_per_ball_against_first(rows: &[BenchRow]) -> Vec<(f64, f64)> {
 
 /// The bench tables as text: the discrete mode's scaling, then continuous against discrete.
 pub fn format_table(rows: &[BenchRow]) -> String {
-    let mut text =
-        String::from("Discrete mode (move, find overlaps, respond), grid broad phase:\n");
+    let mut text = match rows
+        .first()
+        .map(|row| row.one_core.rounds_ms_per_step.len())
+    {
+        Some(rounds @ 2..) => format!(
+            "Each case: its median of {rounds} rounds, run alternately (every round in --json).\n\n"
+        ),
+        _ => String::new(),
+    };
+    text += "Discrete mode (move, find overlaps, respond), grid broad phase:\n";
     text += &format!(
         "{:>8} {:>12} {:>14} {:>14} {:>12} {:>10} {:>13} {:>11}\n",
         "balls",
@@ -355,6 +413,7 @@ mod tests {
             collisions_per_sim_second: 0.0,
             collisions_per_cpu_second: 0.0,
             peak_rss_mib: None,
+            rounds_ms_per_step: Vec::new(),
         };
         let row = |balls, discrete_ms, continuous_ms| BenchRow {
             balls,
@@ -377,5 +436,55 @@ mod tests {
             "{table}"
         );
         assert!(cost_per_ball_against_first(&[]).is_empty());
+    }
+
+    #[test]
+    fn each_case_reports_its_median_round_and_the_highest_peak() {
+        let round = |ms: f64, rss: f64| CaseResult {
+            case: BenchCase {
+                balls: 1000,
+                steps: 10,
+                broad_phase: BroadPhase::Grid,
+                collisions: CollisionMode::Continuous,
+            },
+            cores: 2,
+            threads: 2,
+            ms_per_step_median: ms,
+            ns_per_ball_step: ms * 1e3,
+            contacts_per_step: ms * 10.0,
+            collisions_per_step: 0.0,
+            collisions_per_sim_second: 0.0,
+            collisions_per_cpu_second: 0.0,
+            peak_rss_mib: Some(rss),
+            rounds_ms_per_step: Vec::new(),
+        };
+        let median =
+            CaseResult::median_round(vec![round(3.0, 40.0), round(1.0, 45.0), round(2.0, 41.0)])
+                .unwrap();
+        // The whole of the middle round (its per-ball cost and counts with it), every
+        // round's median in the order run, the highest peak.
+        assert_eq!(median.ms_per_step_median, 2.0);
+        assert_eq!(median.ns_per_ball_step, 2000.0);
+        assert_eq!(median.contacts_per_step, 20.0);
+        assert_eq!(median.rounds_ms_per_step, [3.0, 1.0, 2.0]);
+        assert_eq!(median.peak_rss_mib, Some(45.0));
+        // Of an even count, the faster of the middle two; of none, nothing.
+        let four = [4.0, 1.0, 3.0, 2.0].map(|ms| round(ms, 40.0)).to_vec();
+        assert_eq!(
+            CaseResult::median_round(four).unwrap().ms_per_step_median,
+            2.0
+        );
+        assert_eq!(CaseResult::median_round(Vec::new()), None);
+        let one = CaseResult::median_round(vec![round(5.0, 40.0)]).unwrap();
+        assert_eq!(one.ms_per_step_median, 5.0);
+        let rows = [BenchRow {
+            balls: 1000,
+            one_core: median.clone(),
+            all_cores: median.clone(),
+            all_pairs: None,
+            continuous_one_core: median.clone(),
+            continuous_all_cores: median,
+        }];
+        assert!(format_table(&rows).starts_with("Each case: its median of 3 rounds"));
     }
 }
