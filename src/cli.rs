@@ -110,7 +110,8 @@ pub struct BenchArgs {
     pub all_pairs_max: u64,
     /// Rounds of the gas's cases, each round every case once; each case reports its median
     /// round (a single run moves by up to 10% on a busy machine).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=100))]
+    #[arg(long, default_value_t = 3, conflicts_with_all = ["pile", "mixed"],
+          value_parser = clap::value_parser!(u64).range(1..=100))]
     pub rounds: u64,
     /// Print the rows as JSON instead of a table.
     #[arg(long)]
@@ -367,7 +368,7 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     let rounds = args.rounds as usize;
     let progress = Progress::new(
         (rounds * sizes.len()) as u64,
-        "sizes (every round)",
+        "size-rounds",
         args.quiet || args.json,
     );
     // Round after round, each size's cases once in each.

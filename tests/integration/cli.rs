@@ -160,6 +160,7 @@ fn usage_errors_exit_2() {
             "sideways",
         ],
         &["bench", "--sizes", "200", "--rounds", "0"],
+        &["bench", "--pile", "--rounds", "2"],
     ] {
         let out = ballpit(args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -372,8 +373,15 @@ fn the_bench_runs_every_case_in_its_children() {
         assert_eq!(rounds.len(), 2, "{case}: {row}");
         assert_eq!(median, rounds[0].min(rounds[1]), "{case}: {row}");
     }
-    // Each child ran the mode and broad phase its case asked for.
+    // Each child ran the mode, broad phase and threads its case asked for.
     assert_eq!(row["all_pairs"]["case"]["broad_phase"], "AllPairs");
+    assert_eq!(row["one_core"]["threads"], 1);
+    assert_eq!(row["continuous_one_core"]["threads"], 1);
+    assert_eq!(
+        row["continuous_all_cores"]["case"]["collisions"],
+        "Continuous"
+    );
+    assert_eq!(row["all_cores"]["case"]["collisions"], "Discrete");
     assert_eq!(row["one_core"]["case"]["collisions"], "Discrete");
     assert_eq!(
         row["continuous_one_core"]["case"]["collisions"],

@@ -1,0 +1,205 @@
+//! One bench case: what it runs ([`BenchCase`]), what it measured ([`CaseResult`], and the
+//! median of several rounds of it), and running it, in this process or in a child.
+
+use std::error::Error;
+use std::process::Command;
+
+use serde::{Deserialize, Serialize};
+
+use crate::headless::{DEFAULT_DT, counters_only, headless_app_with_threads, median, time_steps};
+use crate::sim::{BroadPhase, CollisionMode, SceneFile, SimStats, Solver};
+
+/// The standard gas, built in so the bench runs from any directory.
+pub const STANDARD_GAS: &str = include_str!("../../../assets/scenes/gas.ron");
+/// Steps run before timing starts (first-touch allocations, caches).
+const WARM_UP_STEPS: u64 = 5;
+
+/// The text that the command line parses back to `value` (for the bench's children).
+pub fn flag_value(value: impl clap::ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .expect("no flag value is hidden")
+        .get_name()
+        .to_string()
+}
+
+/// One case: how many balls, how many timed steps, which broad phase and collision mode.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchCase {
+    pub balls: usize,
+    pub steps: u64,
+    /// Used by the discrete mode; the continuous mode always uses the grid.
+    pub broad_phase: BroadPhase,
+    pub collisions: CollisionMode,
+}
+
+/// What one case measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseResult {
+    pub case: BenchCase,
+    /// Cores the process could use.
+    pub cores: usize,
+    /// Threads at work on each step (the main thread and the compute pool's workers).
+    pub threads: usize,
+    pub ms_per_step_median: f64,
+    pub ns_per_ball_step: f64,
+    pub contacts_per_step: f64,
+    /// Ball–ball collisions (momentum exchanges) per step.
+    pub collisions_per_step: f64,
+    /// Ball–ball collisions per simulated second.
+    pub collisions_per_sim_second: f64,
+    /// Ball–ball collisions handled per second of computing.
+    pub collisions_per_cpu_second: f64,
+    /// Peak resident memory of the process, MiB (Linux only).
+    pub peak_rss_mib: Option<f64>,
+    /// In `bench`, each round's `ms_per_step_median`, in the order run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rounds_ms_per_step: Vec<f64>,
+}
+
+impl CaseResult {
+    /// The round whose step's median is the median of `rounds`' (the faster of the middle two
+    /// for an even count), with every round's ms a step (in the order run) and the highest
+    /// peak RSS of them all. `None` without rounds.
+    pub fn median_round(rounds: Vec<CaseResult>) -> Option<CaseResult> {
+        let in_order: Vec<f64> = rounds.iter().map(|r| r.ms_per_step_median).collect();
+        let peak_rss_mib = rounds
+            .iter()
+            .filter_map(|r| r.peak_rss_mib)
+            .reduce(f64::max);
+        let mut sorted = rounds;
+        sorted.sort_by(|a, b| a.ms_per_step_median.total_cmp(&b.ms_per_step_median));
+        let middle = sorted.len().checked_sub(1)? / 2;
+        let median = sorted.swap_remove(middle);
+        Some(CaseResult {
+            peak_rss_mib,
+            rounds_ms_per_step: in_order,
+            ..median
+        })
+    }
+}
+
+/// Runs `case` in this process with `threads` threads at work on each step.
+pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn Error>> {
+    let mut scene = SceneFile::parse(STANDARD_GAS, "gas.ron")?;
+    if let Some(generate) = scene.generate.as_mut() {
+        generate.count = case.balls;
+    }
+    let mut app = headless_app_with_threads(DEFAULT_DT, Some(threads));
+    // The scene's own copy of the balls is dropped once they are spawned: at a million balls
+    // it is 40 MB of the peak.
+    scene.build("gas.ron")?.apply(app.world_mut());
+    counters_only(&mut app);
+    app.insert_resource(Solver {
+        collisions: case.collisions,
+        broad_phase: case.broad_phase,
+    });
+    time_steps(&mut app, WARM_UP_STEPS, |_| {});
+    let before = app.world().resource::<SimStats>().clone();
+    let mut step_ms = time_steps(&mut app, case.steps, |_| {});
+    let total_ms: f64 = step_ms.iter().sum();
+    let after = app.world().resource::<SimStats>();
+    let collisions = (after.ball_collisions - before.ball_collisions) as f64;
+    let contacts = (after.contact_points - before.contact_points) as f64;
+    let steps = case.steps.max(1) as f64;
+    let median = median(&mut step_ms);
+    Ok(CaseResult {
+        case,
+        cores: available_cores(),
+        threads,
+        ms_per_step_median: median,
+        ns_per_ball_step: median * 1e6 / case.balls.max(1) as f64,
+        contacts_per_step: contacts / steps,
+        collisions_per_step: collisions / steps,
+        collisions_per_sim_second: collisions / (steps * DEFAULT_DT),
+        collisions_per_cpu_second: collisions / (total_ms.max(f64::MIN_POSITIVE) * 1e-3),
+        peak_rss_mib: peak_rss_mib(),
+        rounds_ms_per_step: Vec::new(),
+    })
+}
+
+/// Cores this process may run on (fewer under `taskset`).
+pub fn available_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The process's peak resident set size, MiB, from `/proc/self/status` (Linux).
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|line| line.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// Runs `case` in a child process: on one core with one thread if `one_core` (via
+/// `taskset`), else with a thread per core (the main thread and a worker for each other core).
+pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, Box<dyn Error>> {
+    let threads = if one_core { 1 } else { available_cores() };
+    let exe = std::env::current_exe()?;
+    let mut command = if one_core {
+        let mut taskset = Command::new("taskset");
+        taskset.args(["-c", "0"]).arg(exe);
+        taskset
+    } else {
+        Command::new(exe)
+    };
+    let output = command
+        .args([
+            "bench-one",
+            "--balls",
+            &case.balls.to_string(),
+            "--steps",
+            &case.steps.to_string(),
+        ])
+        .args([
+            "--broad-phase",
+            &flag_value(case.broad_phase),
+            "--threads",
+            &threads.to_string(),
+            "--collisions",
+            &flag_value(case.collisions),
+        ])
+        .output()
+        .map_err(|e| {
+            format!(
+                "cannot start the bench child{}: {e}",
+                if one_core {
+                    " (is taskset installed?)"
+                } else {
+                    ""
+                }
+            )
+        })?;
+    if !output.status.success() {
+        return Err(format!(
+            "bench child failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        )
+        .into());
+    }
+    Ok(serde_json::from_slice(&output.stdout)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    use super::*;
+
+    #[test]
+    fn flag_values_parse_back_to_the_same_modes() {
+        for mode in CollisionMode::ALL {
+            let text = flag_value(mode);
+            assert_eq!(CollisionMode::from_str(&text, false), Ok(mode), "{text}");
+        }
+        for broad_phase in [BroadPhase::Grid, BroadPhase::AllPairs] {
+            let text = flag_value(broad_phase);
+            assert_eq!(
+                BroadPhase::from_str(&text, false),
+                Ok(broad_phase),
+                "{text}"
+            );
+        }
+        assert_eq!(flag_value(BroadPhase::AllPairs), "all-pairs");
+    }
+}
