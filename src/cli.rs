@@ -10,7 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case, run_case_in_child};
+use crate::commands::bench::{BenchCase, BenchRow, format_table, run_case};
 use crate::commands::mixed::{format_mixed_table, run_mixed};
 use crate::commands::observe::dump::StateDump;
 use crate::commands::observe::{ObserveRequest, Observers};
@@ -375,7 +375,11 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
     let mut by_size: Vec<Vec<BenchRow>> = vec![Vec::new(); sizes.len()];
     for _ in 0..rounds {
         for (&balls, rows) in sizes.iter().zip(&mut by_size) {
-            rows.push(bench_row(balls as usize, steps, args.all_pairs_max)?);
+            rows.push(BenchRow::measure(
+                balls as usize,
+                steps,
+                args.all_pairs_max,
+            )?);
             progress.advance(1);
         }
     }
@@ -390,35 +394,6 @@ fn run_bench(args: BenchArgs) -> Result<(), Box<dyn Error>> {
         print_out(&format_table(&rows))?;
     }
     Ok(())
-}
-
-/// One size's bench cases, each once, in its own child process.
-fn bench_row(balls: usize, steps: u64, all_pairs_max: u64) -> Result<BenchRow, Box<dyn Error>> {
-    let discrete = BenchCase {
-        balls,
-        steps,
-        broad_phase: BroadPhase::Grid,
-        collisions: CollisionMode::Discrete,
-    };
-    let all_pairs = (balls as u64 <= all_pairs_max).then_some(BenchCase {
-        steps: (steps / 10).max(5),
-        broad_phase: BroadPhase::AllPairs,
-        ..discrete
-    });
-    let continuous = BenchCase {
-        collisions: CollisionMode::Continuous,
-        ..discrete
-    };
-    Ok(BenchRow {
-        balls,
-        one_core: run_case_in_child(discrete, true)?,
-        all_cores: run_case_in_child(discrete, false)?,
-        all_pairs: all_pairs
-            .map(|case| run_case_in_child(case, true))
-            .transpose()?,
-        continuous_one_core: run_case_in_child(continuous, true)?,
-        continuous_all_cores: run_case_in_child(continuous, false)?,
-    })
 }
 
 fn run_pile_bench(args: &BenchArgs) -> Result<(), Box<dyn Error>> {

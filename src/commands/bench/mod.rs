@@ -18,6 +18,6 @@ mod case;
 mod rows;
 mod table;
 
-pub use case::{BenchCase, CaseResult, run_case, run_case_in_child};
+pub use case::{BenchCase, CaseResult, run_case};
 pub use rows::BenchRow;
 pub use table::format_table;

@@ -1,10 +1,13 @@
 //! One size's row of the bench ([`BenchRow`]): its cases on one core and on all, the
-//! all-pairs reference, the continuous mode; the row from several rounds, and the ratios the
-//! tables print.
+//! all-pairs reference, the continuous mode, each run in its own child; the row from several
+//! rounds, and the ratios the tables print.
+
+use std::error::Error;
 
 use serde::Serialize;
 
-use super::case::CaseResult;
+use super::case::{BenchCase, CaseResult, run_case_in_child};
+use crate::sim::{BroadPhase, CollisionMode};
 
 /// One row of the bench table: a size, on one core and on all cores, against all pairs.
 #[derive(Clone, Debug, Serialize)]
@@ -20,6 +23,36 @@ pub struct BenchRow {
 }
 
 impl BenchRow {
+    /// The row of `balls` balls: each case once, `steps` steps, in its own child process; the
+    /// all-pairs reference up to `all_pairs_max` balls.
+    pub fn measure(balls: usize, steps: u64, all_pairs_max: u64) -> Result<Self, Box<dyn Error>> {
+        let discrete = BenchCase {
+            balls,
+            steps,
+            broad_phase: BroadPhase::Grid,
+            collisions: CollisionMode::Discrete,
+        };
+        let all_pairs = (balls as u64 <= all_pairs_max).then_some(BenchCase {
+            steps: (steps / 10).max(5),
+            broad_phase: BroadPhase::AllPairs,
+            ..discrete
+        });
+        let continuous = BenchCase {
+            collisions: CollisionMode::Continuous,
+            ..discrete
+        };
+        Ok(BenchRow {
+            balls,
+            one_core: run_case_in_child(discrete, true)?,
+            all_cores: run_case_in_child(discrete, false)?,
+            all_pairs: all_pairs
+                .map(|case| run_case_in_child(case, true))
+                .transpose()?,
+            continuous_one_core: run_case_in_child(continuous, true)?,
+            continuous_all_cores: run_case_in_child(continuous, false)?,
+        })
+    }
+
     /// One size's rows from several rounds as one: each case its [median
     /// round](CaseResult::median_round). `None` without rounds.
     pub fn median_of_rounds(rounds: Vec<BenchRow>) -> Option<BenchRow> {
