@@ -1,7 +1,8 @@
 //! Stage 3's loads ahead, continuous: what the impacts about to be taken will read, brought
 //! into the cache before they read it. Impacts come in time order, so each one's balls lie
 //! anywhere in memory, and at a million balls waiting for those reads is most of an impact's
-//! cost (docs/performance.md, *Prefetching the coming impacts*). The timeline's loop calls
+//! cost (docs/performance.md, *Prefetching the coming impacts* and *The loads ahead in three
+//! stages*). The timeline's loop calls
 //! [`Timeline::prefetch_coming`] before each impact; nothing here changes a result.
 
 use super::impact::Impact;
@@ -9,8 +10,8 @@ use super::state::{Mover, Timeline};
 use crate::sim::cache::{PREFETCH_MIN_BALLS, prefetch};
 
 /// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
-/// cells around a ball (and twice as many ahead, the balls themselves): 2 and 8 did as well
-/// at a million balls.
+/// cells around a ball (half as many again ahead, where their rows start; twice as many, the
+/// balls themselves): 2 and 8 did as well at a million balls.
 const PREFETCH_DISTANCE: usize = 4;
 
 impl Timeline {
@@ -25,12 +26,16 @@ impl Timeline {
     /// they are: impacts come in time order, so each one's balls lie anywhere in memory, and
     /// at a million balls waiting for those reads is most of an impact's cost
     /// (docs/performance.md, *Prefetching the coming impacts*). For the step's first
-    /// predictions a few places ahead, the balls first and, nearer, the cells around the first
-    /// ball (which need its cell, loaded with the balls); for the earliest impact predicted
+    /// predictions a few places ahead, in three stages, each reading only what the one before
+    /// loaded: the balls and their cells; nearer, where the rows of cells around the first
+    /// ball start; nearer still, those rows' first circles. For the earliest impact predicted
     /// since, all at once. Nothing here changes a result.
     pub(super) fn prefetch_coming(&self) {
         if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
             self.prefetch_balls(further);
+        }
+        if let Some(middle) = self.queue.ahead(PREFETCH_DISTANCE * 3 / 2) {
+            self.grid.prefetch_cell_starts_around(middle.a as usize);
         }
         if let Some(nearer) = self.queue.ahead(PREFETCH_DISTANCE) {
             self.grid.prefetch_cells_around(nearer.a as usize);
@@ -41,11 +46,13 @@ impl Timeline {
         }
     }
 
-    /// Loads the movers of `impact`'s balls and the first one's slot in the grid.
+    /// Loads the movers of `impact`'s balls and their slots in the grid (the second's circle
+    /// is read to tell whether the first's search would find it).
     fn prefetch_balls(&self, impact: Impact) {
         prefetch_mover(&self.movers, impact.a);
         if impact.wall().is_none() {
             prefetch_mover(&self.movers, impact.other);
+            self.grid.prefetch_slot(impact.other as usize);
         }
         self.grid.prefetch_slot(impact.a as usize);
     }

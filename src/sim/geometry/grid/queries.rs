@@ -59,14 +59,29 @@ impl UniformGrid {
         prefetch(self.sorted_circle.get(slot));
     }
 
-    /// Brings the first circle of each row of cells around the ball in `slot` (its cell's
+    /// Brings where each row of cells around the ball in `slot` (its cell's row and the rows
+    /// beside it, three cells wide) starts into the cache: what
+    /// [`prefetch_cells_around`](Self::prefetch_cells_around) reads. Best some time after
+    /// [`prefetch_slot`](Self::prefetch_slot), which brings the ball's cell, read here.
+    pub fn prefetch_cell_starts_around(&self, slot: usize) {
+        for cells in self.cell_runs_around(slot) {
+            prefetch(self.cell_start.get(cells.start));
+        }
+    }
+
+    /// Brings the first circles of each row of cells around the ball in `slot` (its cell's
     /// row and the rows beside it, three cells wide) into the cache, as
     /// [`prefetch_slot`](Self::prefetch_slot) does: where a query around the ball will read.
-    /// Best some time after `prefetch_slot`, which brings the ball's cell, read here.
+    /// A row of three cells holds four or five circles of the gas, 24 B each: the first and
+    /// the fourth fall in its first two cache lines. Best some time after
+    /// [`prefetch_cell_starts_around`](Self::prefetch_cell_starts_around), which brings what
+    /// is read here.
     pub fn prefetch_cells_around(&self, slot: usize) {
         for cells in self.cell_runs_around(slot) {
             let first_slot = self.cell_start.get(cells.start).map(|&slot| slot as usize);
-            prefetch(first_slot.and_then(|slot| self.sorted_circle.get(slot)));
+            for offset in [0, 3] {
+                prefetch(first_slot.and_then(|slot| self.sorted_circle.get(slot + offset)));
+            }
         }
     }
 
@@ -214,6 +229,7 @@ mod tests {
             }
             inner += usize::from(runs.len() == 3 && runs[0].len() == 3);
             grid.prefetch_slot(slot);
+            grid.prefetch_cell_starts_around(slot);
             grid.prefetch_cells_around(slot);
         }
         assert!(inner > 0);
@@ -221,6 +237,7 @@ mod tests {
         for slot in grid.small_count()..grid.len() + 3 {
             assert_eq!(grid.cell_runs_around(slot).count(), 0, "slot {slot}");
             grid.prefetch_slot(slot);
+            grid.prefetch_cell_starts_around(slot);
             grid.prefetch_cells_around(slot);
         }
         assert!(grid.small_count() < grid.len(), "some big balls");
