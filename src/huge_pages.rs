@@ -147,9 +147,10 @@ fn kernel_gives_huge_pages_when_asked() -> bool {
 }
 
 /// Whether this process's `malloc` marks its large blocks for huge pages, as the tunable asks.
-/// glibc 2.35 and 2.36 read the kernel's mode into a buffer one byte too short for the end
-/// of the text and compare it as a string, so whether they see `madvise` depends on the byte
-/// that follows on the stack, which moves with the address space's random layout: in about
+/// glibc 2.35 and 2.36 read the kernel's mode into a buffer and compare it as a string
+/// without ending it (later releases end it: `str[s] = '\0'` in `malloc-hugepages.c`), so
+/// whether they see `madvise` depends on the byte that follows on the stack, which moves
+/// with the address space's random layout and the program's path and arguments: in about
 /// half the starts they let the tunable go by (on this project's machine, 3 of 6 runs of
 /// 1,000,000 balls and 4 of 8 of 300,000). So a block of [`PROBE_BYTES`], which `malloc`
 /// maps on its own, is looked up in `/proc/self/smaps`: marked, it may have huge pages
