@@ -152,7 +152,7 @@ fn kernel_gives_huge_pages_when_asked() -> bool {
 /// whether they see `madvise` depends on the byte that follows on the stack, which moves
 /// with the address space's random layout and the program's path and arguments: in about
 /// half the starts they let the tunable go by (on this project's machine, 3 of 6 runs of
-/// 1,000,000 balls and 4 of 8 of 300,000). So a block of [`PROBE_BYTES`], which `malloc`
+/// 1,000,000 balls and 5 of 12 of 300,000). So a block of [`PROBE_BYTES`], which `malloc`
 /// maps on its own, is looked up in `/proc/self/smaps`: marked, it may have huge pages
 /// (`THPeligible: 1`). If the file cannot be read, the answer is yes: run on.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
