@@ -52,18 +52,26 @@ pub fn tunables_with_huge_pages(current: Option<&OsStr>) -> Option<OsString> {
     (well_formed && !named).then(|| format!("{current}:{asked}").into())
 }
 
-/// The `GLIBC_TUNABLES` to start again with, given the environment's [`RESTARTED`],
-/// `LD_PRELOAD` and `GLIBC_TUNABLES`; `None` not to start again: this is the second start,
-/// valgrind runs it, or the tunables are to be left alone ([`tunables_with_huge_pages`]).
-pub fn tunables_for_a_second_start(
+/// The start to make, as its `GLIBC_TUNABLES` and its number ([`RESTARTED`]), given the
+/// environment's [`RESTARTED`], `LD_PRELOAD` and `GLIBC_TUNABLES`; `None` to run on. A start
+/// made here starts once more only if `missed_the_pages()` (asked only there), with the
+/// tunables it was given, while its number allows ([`next_start`]); the first start, unless
+/// valgrind runs it or the tunables are to be left alone ([`tunables_with_huge_pages`]).
+pub fn start_to_make(
     restarted: Option<&OsStr>,
     preloaded: Option<&OsStr>,
     tunables: Option<&OsStr>,
-) -> Option<OsString> {
-    if restarted.is_some() || under_valgrind(preloaded) {
-        return None;
+    missed_the_pages: impl FnOnce() -> bool,
+) -> Option<(OsString, u32)> {
+    match restarted {
+        Some(restarted) => {
+            let start = next_start(restarted)?;
+            let tunables = tunables?.to_owned();
+            missed_the_pages().then_some((tunables, start))
+        }
+        None if under_valgrind(preloaded) => None,
+        None => Some((tunables_with_huge_pages(tunables)?, 2)),
     }
-    tunables_with_huge_pages(tunables)
 }
 
 /// Whether the preloaded libraries (`LD_PRELOAD`) are valgrind's, which it gives every
@@ -93,19 +101,16 @@ pub fn rerun_with_huge_pages() {
 
     let env = std::env::var_os;
     let (restarted, preloaded, tunables) = (env(RESTARTED), env("LD_PRELOAD"), env(TUNABLES));
-    let (tunables, start) = match restarted.as_deref().map(next_start) {
-        // A start made here: again only if glibc did not take the pages.
-        Some(Some(start)) if kernel_gives_huge_pages_when_asked() && !glibc_took_huge_pages() => {
-            (tunables, start)
-        }
-        Some(_) => return,
-        None => {
-            let first =
-                tunables_for_a_second_start(None, preloaded.as_deref(), tunables.as_deref());
-            (first, 2)
-        }
+    let missed_the_pages = || kernel_gives_huge_pages_when_asked() && !glibc_took_huge_pages();
+    let Some((tunables, start)) = start_to_make(
+        restarted.as_deref(),
+        preloaded.as_deref(),
+        tunables.as_deref(),
+        missed_the_pages,
+    ) else {
+        return;
     };
-    let (Some(tunables), Ok(binary)) = (tunables, std::env::current_exe()) else {
+    let Ok(binary) = std::env::current_exe() else {
         return;
     };
     if is_the_loader(&binary) {
@@ -228,21 +233,29 @@ mod tests {
     }
 
     #[test]
-    fn it_starts_again_at_most_once_and_never_under_valgrind() {
+    fn it_starts_again_until_glibc_takes_the_pages_and_never_under_valgrind() {
         let os = |value: &'static str| Some(OsStr::new(value));
-        let asked = Some(OsString::from("glibc.malloc.hugetlb=1"));
-        assert_eq!(tunables_for_a_second_start(None, None, None), asked);
-        assert_eq!(
-            tunables_for_a_second_start(None, os("libfoo.so"), None),
-            asked
-        );
-        // The second start, even where glibc dropped the tunable it was given.
-        assert_eq!(tunables_for_a_second_start(os("1"), None, None), None);
+        let asked = OsString::from("glibc.malloc.hugetlb=1");
+        // The first start is decided without looking for the pages.
+        let first = |preloaded, tunables| {
+            start_to_make(None, preloaded, tunables, || unreachable!("no probe"))
+        };
+        assert_eq!(first(None, None), Some((asked.clone(), 2)));
+        assert_eq!(first(os("libfoo.so"), None), Some((asked.clone(), 2)));
         let valgrind = os("/usr/libexec/valgrind/vgpreload_core-amd64-linux.so");
-        assert_eq!(tunables_for_a_second_start(None, valgrind, None), None);
+        assert_eq!(first(valgrind, None), None);
         // The user's own choice.
-        let off = os("glibc.malloc.hugetlb=0");
-        assert_eq!(tunables_for_a_second_start(None, None, off), None);
+        assert_eq!(first(None, os("glibc.malloc.hugetlb=0")), None);
+        // A start made here that has the pages runs on; one that missed them starts once
+        // more with the same tunables, up to the last start.
+        let made = |restarted, missed| start_to_make(os(restarted), None, os("x=1"), || missed);
+        assert_eq!(made("2", false), None);
+        assert_eq!(made("2", true), Some((OsString::from("x=1"), 3)));
+        assert_eq!(made("1", true), Some((OsString::from("x=1"), 2)));
+        assert_eq!(made("7", true), None);
+        // Where glibc dropped the tunable it was given, nothing to start with.
+        assert_eq!(start_to_make(os("2"), None, None, || true), None);
+        assert_eq!(start_to_make(os("1"), None, None, || false), None);
     }
 
     #[test]
