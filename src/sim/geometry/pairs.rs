@@ -4,6 +4,8 @@
 
 use std::ops::Range;
 
+use crossbeam_utils::CachePadded;
+
 use super::circle::{Circle, ContactGeometry, circle_contact, circles_touch};
 use super::grid::{UniformGrid, for_each_pair};
 use crate::sim::parallel::{compute_pool, split_evenly, threads_at_work, worth_splitting};
@@ -26,7 +28,9 @@ const BANDS_PER_THREAD: usize = 4;
 /// while the number of bands and the pairs' count stay about the same.
 #[derive(Debug)]
 pub struct FoundInBands<T> {
-    bands: Vec<Vec<T>>,
+    /// Each band's buffer on cache lines of its own: the threads push to their bands at once,
+    /// and two buffers' lengths on one line would pass it back and forth between the cores.
+    bands: Vec<CachePadded<Vec<T>>>,
 }
 
 impl<T> Default for FoundInBands<T> {
@@ -38,34 +42,34 @@ impl<T> Default for FoundInBands<T> {
 impl<T> FoundInBands<T> {
     /// Every pair found, band after band.
     pub fn iter(&self) -> impl Iterator<Item = &T> + Clone {
-        self.bands.iter().flatten()
+        self.bands.iter().flat_map(|band| band.iter())
     }
 
     /// The bands' pairs, band after band.
     pub fn bands(&self) -> impl Iterator<Item = &[T]> {
-        self.bands.iter().map(Vec::as_slice)
+        self.bands.iter().map(|band| band.as_slice())
     }
 
     /// How many pairs were found.
     pub fn len(&self) -> usize {
-        self.bands.iter().map(Vec::len).sum()
+        self.bands.iter().map(|band| band.len()).sum()
     }
 
     /// Whether no pair was found.
     pub fn is_empty(&self) -> bool {
-        self.bands.iter().all(Vec::is_empty)
+        self.bands.iter().all(|band| band.is_empty())
     }
 
     /// Empties every band, their buffers kept.
     pub fn clear(&mut self) {
-        self.bands.iter_mut().for_each(Vec::clear);
+        self.bands.iter_mut().for_each(|band| band.clear());
     }
 
     /// Empties every band and keeps `count` of them (at least one), their buffers kept.
-    fn clear_to(&mut self, count: usize) -> &mut [Vec<T>] {
+    fn clear_to(&mut self, count: usize) -> &mut [CachePadded<Vec<T>>] {
         self.bands.truncate(count.max(1));
         self.clear();
-        self.bands.resize_with(count.max(1), Vec::new);
+        self.bands.resize_with(count.max(1), CachePadded::default);
         &mut self.bands
     }
 }
@@ -140,14 +144,14 @@ pub fn search_in_bands<T: Send + 'static>(
     // the bands' buffers, all alive until joined, are not doubled past what they hold; made
     // here, not on the pool's threads, whose own heaps would keep them after.
     let share = found.capacity() / band_count;
-    let mut bands: Vec<Vec<T>> = (0..band_count)
-        .map(|_| Vec::with_capacity(share + share / 8))
+    let mut bands: Vec<CachePadded<Vec<T>>> = (0..band_count)
+        .map(|_| CachePadded::new(Vec::with_capacity(share + share / 8)))
         .collect();
     search_bands(grid, &mut bands, search);
     // Exactly what is needed: the buffer is kept from step to step, and doubling it would
     // leave up to half of it unused (megabytes at a million balls).
-    found.reserve_exact(bands.iter().map(Vec::len).sum());
-    found.extend(bands.into_iter().flatten());
+    found.reserve_exact(bands.iter().map(|band| band.len()).sum());
+    found.extend(bands.into_iter().flat_map(CachePadded::into_inner));
 }
 
 /// How many bands of rows the grid is searched in: one on one thread or for few balls, else
@@ -164,7 +168,7 @@ fn band_count(grid: &UniformGrid) -> usize {
 /// row order, on the compute pool when there is more than one band.
 fn search_bands<T: Send>(
     grid: &UniformGrid,
-    bands: &mut [Vec<T>],
+    bands: &mut [CachePadded<Vec<T>>],
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
     let rows = grid.rows();

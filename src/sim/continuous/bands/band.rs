@@ -33,14 +33,21 @@ pub(super) struct Band {
 }
 
 impl Band {
-    /// Its balls, own and halo, from the step's arrays.
-    pub(super) fn gather(
+    /// Its balls, own and halo (a halo `halo` px wide on each side), gathered from the step's
+    /// arrays, and their impacts predicted.
+    pub(super) fn predict(
         &mut self,
-        circles: &[Circle],
-        velocities: &[DVec2],
-        held: &[bool],
+        (circles, velocities, held): (&[Circle], &[DVec2], &[bool]),
         halo: f64,
+        spec: StepSpec,
     ) {
+        self.gather(circles, velocities, held, halo);
+        self.timeline
+            .predict(&self.circles, &self.velocities, &self.held, spec);
+    }
+
+    /// Its balls, own and halo, from the step's arrays.
+    fn gather(&mut self, circles: &[Circle], velocities: &[DVec2], held: &[bool], halo: f64) {
         let (low, high) = (self.low, self.high);
         self.balls.clear();
         self.own.clear();
