@@ -11,6 +11,7 @@ use bevy::math::DVec2;
 
 use super::cells::CellMap;
 use super::counting::{NO_CELL, cells_of_slots, sort_bands, sort_into_cells};
+use super::extent::Extent;
 use super::rows::RowLists;
 use super::touching::for_each_touching;
 use crate::sim::geometry::circle::Circle;
@@ -52,46 +53,6 @@ pub struct UniformGrid {
     big_rows: RowLists,
 }
 
-/// What a pass over some balls finds: the box of their centres, the sum of their radii and
-/// the largest radius.
-#[derive(Clone, Copy)]
-struct Extent {
-    min: DVec2,
-    max: DVec2,
-    radius_sum: f64,
-    largest_radius: f64,
-}
-
-impl Extent {
-    /// No ball yet.
-    const NONE: Self = Self {
-        min: DVec2::MAX,
-        max: DVec2::MIN,
-        radius_sum: 0.0,
-        largest_radius: 0.0,
-    };
-
-    /// With `circle` too.
-    fn with(self, circle: Circle) -> Self {
-        self.joined(Self {
-            min: circle.center,
-            max: circle.center,
-            radius_sum: circle.radius,
-            largest_radius: circle.radius,
-        })
-    }
-
-    /// Both passes' balls, `self`'s first (the sums are added in that order).
-    fn joined(self, other: Self) -> Self {
-        Self {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-            radius_sum: self.radius_sum + other.radius_sum,
-            largest_radius: self.largest_radius.max(other.largest_radius),
-        }
-    }
-}
-
 /// Whether a ball of `radius` is big where the limit is `big_limit`. A NaN is not big.
 fn is_big(radius: f64, big_limit: f64) -> bool {
     radius > big_limit
@@ -111,7 +72,7 @@ impl UniformGrid {
         // piece's size is fixed, so the mean's rounding never depends on the threads.
         let parallel = worth_splitting(count);
         let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
-            balls.map(&circle_at).fold(Extent::NONE, Extent::with)
+            Extent::of(balls, &circle_at)
         });
         let all = by_piece.into_iter().fold(Extent::NONE, Extent::joined);
         let (mut min, mut max, radius_sum) = (all.min, all.max, all.radius_sum);
