@@ -13,7 +13,7 @@ use super::cells::CellMap;
 use super::counting::{NO_CELL, cells_of_slots, sort_bands, sort_into_cells};
 use super::extent::Extent;
 use super::rows::RowLists;
-use super::touching::for_each_touching;
+use super::touching::TouchingRuns;
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
     BALLS_PER_PIECE, carve, in_pieces, piece_ranges, split_evenly, threads_at_work, worth_splitting,
@@ -278,6 +278,7 @@ impl UniformGrid {
         // contiguous slot ranges, the rest of its own cell with the right cell, and the run
         // above, each tested without a branch per candidate.
         let columns = self.cells.columns;
+        let mut runs = TouchingRuns::new();
         for row in rows {
             for column in 0..columns {
                 let cell = row * columns + column;
@@ -300,7 +301,7 @@ impl UniformGrid {
                 for slot in start..end {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
                     for range in [slot + 1..same_row_end, above.clone()] {
-                        for_each_touching(circle, range, &self.sorted_circle, |other| {
+                        runs.for_each_touching(circle, range, &self.sorted_circle, |other| {
                             visit(
                                 index,
                                 self.sorted_index[other],
@@ -312,7 +313,7 @@ impl UniformGrid {
                 }
             }
             if self.big_grid().is_some() {
-                self.visit_big_with_small_in_row(row, &mut visit);
+                self.visit_big_with_small_in_row(row, &mut runs, &mut visit);
             }
         }
     }
@@ -330,6 +331,7 @@ impl UniformGrid {
     fn visit_big_with_small_in_row(
         &self,
         row: usize,
+        runs: &mut TouchingRuns,
         visit: &mut impl FnMut(u32, u32, Circle, Circle),
     ) {
         for &k in self.big_rows.in_row(row) {
@@ -338,7 +340,7 @@ impl UniformGrid {
             let ((first, _), (last, _)) = self.cells.corners_reached(circle, self.small_reach);
             let start = row * self.cells.columns;
             let slots = self.slots_of(start + first..start + last + 1);
-            for_each_touching(circle, slots, &self.sorted_circle, |other| {
+            runs.for_each_touching(circle, slots, &self.sorted_circle, |other| {
                 visit(
                     index,
                     self.sorted_index[other],
