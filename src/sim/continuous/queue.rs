@@ -3,7 +3,9 @@
 //! (after an impact redirects a ball) fall into buckets by time, as in a calendar queue: only
 //! the earliest bucket's impacts are in a heap, which stays small enough for the cache however
 //! many balls there are, and each of the others is a plain list until its turn. Taking the
-//! earlier of the two heads gives the order one heap of them all would give.
+//! earlier of the two heads gives the order one heap of them all would give. The first
+//! predictions are sorted the same way: spread over buckets of time, a few to a bucket, and
+//! each bucket sorted.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -18,6 +20,9 @@ pub struct ImpactQueue {
     next: usize,
     /// The impacts predicted since, by bucket of time.
     later: Buckets,
+    /// [`sort_in_buckets`]'s buffers, kept from step to step.
+    spare: Vec<Impact>,
+    bucket_ends: Vec<u32>,
 }
 
 impl ImpactQueue {
@@ -28,7 +33,9 @@ impl ImpactQueue {
         // Exactly what is needed: the buffer is kept from step to step.
         self.sorted.reserve_exact(impacts.clone().count());
         self.sorted.extend(impacts);
-        self.sorted.sort_unstable();
+        let buckets = TimeBuckets::over(horizon, self.sorted.len() / IMPACTS_PER_SORTED_BUCKET);
+        let buffers = (&mut self.spare, &mut self.bucket_ends);
+        sort_in_buckets(&mut self.sorted, buckets, buffers);
         self.next = 0;
         self.later.start(horizon, self.sorted.len());
     }
@@ -74,8 +81,8 @@ struct Buckets {
     lists: Vec<Vec<Impact>>,
     /// The bucket whose impacts are in the heap; while the heap is empty, every list is too.
     current: usize,
-    /// Buckets per second.
-    scale: f64,
+    /// Which bucket an impact's time falls in.
+    by_time: TimeBuckets,
 }
 
 /// About this many impacts predicted at a step's start per bucket: the buckets in use then
@@ -89,28 +96,17 @@ impl Buckets {
     /// Empty, in buckets over `horizon` seconds, as many as suit a step that started with
     /// `first` impacts.
     fn start(&mut self, horizon: f64, first: usize) {
-        let count = (first / IMPACTS_PER_BUCKET).clamp(1, MAX_BUCKETS);
-        self.lists.resize_with(count, Vec::new);
-        self.lists.truncate(count);
+        self.by_time = TimeBuckets::over(horizon, (first / IMPACTS_PER_BUCKET).min(MAX_BUCKETS));
+        self.lists.resize_with(self.by_time.count, Vec::new);
+        self.lists.truncate(self.by_time.count);
         self.lists.iter_mut().for_each(Vec::clear);
         self.heap.clear();
         self.current = 0;
-        // A horizon that is not a positive number puts everything into one bucket.
-        self.scale = if horizon > 0.0 && horizon.is_finite() {
-            count as f64 / horizon
-        } else {
-            0.0
-        };
     }
 
-    /// The bucket of an impact at `time`: never smaller for a later time.
+    /// The bucket of an impact at `time`.
     fn bucket_of(&self, time: f64) -> usize {
-        let last = self.lists.len().saturating_sub(1);
-        if time.is_nan() && time.is_sign_positive() {
-            return last; // after every other time
-        }
-        // `as` rounds down and saturates: a negative time (or NaN) to 0, a huge one to the max.
-        ((time * self.scale) as usize).min(last)
+        self.by_time.of(time)
     }
 
     fn earliest(&self) -> Option<&Impact> {
@@ -148,6 +144,81 @@ impl Buckets {
             buffer.extend(self.lists[next].drain(..).map(Reverse));
             self.heap = BinaryHeap::from(buffer);
         }
+    }
+}
+
+/// About this many of a step's first impacts to a bucket in [`sort_in_buckets`]: so few that
+/// sorting a bucket takes a handful of comparisons.
+const IMPACTS_PER_SORTED_BUCKET: usize = 4;
+
+/// Buckets of time over `[0, horizon]` seconds: the bucket of a later time (in
+/// `f64::total_cmp`'s order) is never an earlier one.
+#[derive(Clone, Copy, Debug, Default)]
+struct TimeBuckets {
+    count: usize,
+    /// Buckets per second.
+    scale: f64,
+}
+
+impl TimeBuckets {
+    /// `count` buckets (at least one) over `horizon` seconds; a horizon that is not a positive
+    /// number puts everything into one bucket.
+    fn over(horizon: f64, count: usize) -> Self {
+        let count = count.max(1);
+        let scale = if horizon > 0.0 && horizon.is_finite() {
+            count as f64 / horizon
+        } else {
+            0.0
+        };
+        Self { count, scale }
+    }
+
+    /// The bucket of `time`.
+    fn of(&self, time: f64) -> usize {
+        let last = self.count - 1;
+        if time.is_nan() && time.is_sign_positive() {
+            return last; // after every other time
+        }
+        // `as` rounds down and saturates: a negative time (or NaN) to 0, a huge one to the max.
+        ((time * self.scale) as usize).min(last)
+    }
+}
+
+/// Sorts `impacts` as `sort_unstable` does: spread over `buckets` by time (a counting sort,
+/// through `spare`; `bucket_ends` ends as each bucket's end), then each bucket sorted on its
+/// own. Every impact in a bucket comes before every one in a later bucket, and with a few to
+/// a bucket each comparison of two `Impact`s, most of the cost, is spared all but a few times.
+fn sort_in_buckets(
+    impacts: &mut [Impact],
+    buckets: TimeBuckets,
+    (spare, bucket_ends): (&mut Vec<Impact>, &mut Vec<u32>),
+) {
+    if buckets.count == 1 {
+        impacts.sort_unstable();
+        return;
+    }
+    // Each bucket's size, then where it starts.
+    bucket_ends.clear();
+    bucket_ends.resize(buckets.count, 0);
+    for impact in impacts.iter() {
+        bucket_ends[buckets.of(impact.time)] += 1;
+    }
+    let mut start = 0;
+    for entry in bucket_ends.iter_mut() {
+        (start, *entry) = (start + *entry, start);
+    }
+    // Each impact to the next place in its bucket: each entry moves on to its bucket's end.
+    spare.clear();
+    spare.extend_from_slice(impacts);
+    for &impact in spare.iter() {
+        let next = &mut bucket_ends[buckets.of(impact.time)];
+        impacts[*next as usize] = impact;
+        *next += 1;
+    }
+    let mut start = 0;
+    for &end in bucket_ends.iter() {
+        impacts[start..end as usize].sort_unstable();
+        start = end as usize;
     }
 }
 
@@ -220,6 +291,48 @@ mod tests {
                 horizon > 0.0,
                 "{most_waiting} waiting at most"
             );
+        }
+    }
+
+    #[test]
+    fn sorting_in_buckets_gives_the_order_of_one_sort() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let party = |index: u32| Party {
+            slot: index as usize,
+            index,
+            hits: 0,
+        };
+        // Times within the horizon, many equal; a few before it, past it, or not numbers.
+        let time = |k: usize, rng: &mut ChaCha8Rng| match k % 50 {
+            0 => -0.001,
+            1 => 0.03,
+            2 => f64::NAN,
+            3 => -f64::NAN,
+            4 => f64::INFINITY,
+            5..=20 => (k % 7) as f64 / 420.0,
+            _ => rng.random_range(0.0..1.0 / 60.0),
+        };
+        let (mut spare, mut ends) = (Vec::new(), Vec::new());
+        for count in [0, 1, 7, 1000, 5000] {
+            let impacts: Vec<Impact> = (0..count)
+                .map(|k| {
+                    let pair = (rng.random_range(0..40), rng.random_range(40..80));
+                    Impact::between(time(k, &mut rng), party(pair.0), party(pair.1))
+                })
+                .collect();
+            let mut expected = impacts.clone();
+            expected.sort_unstable();
+            for buckets in [1, 3, count / IMPACTS_PER_SORTED_BUCKET, 4 * count] {
+                let mut sorted = impacts.clone();
+                let by_time = TimeBuckets::over(1.0 / 60.0, buckets);
+                sort_in_buckets(&mut sorted, by_time, (&mut spare, &mut ends));
+                // `Debug` tells NaN times apart, where `==` would not.
+                assert_eq!(
+                    format!("{sorted:?}"),
+                    format!("{expected:?}"),
+                    "{count} impacts in {buckets} buckets"
+                );
+            }
         }
     }
 
