@@ -5,6 +5,7 @@
 //! Positions and velocities are `f64`: the collision maths (and the continuous mode's time of
 //! impact) keep energy to 1e-6 only with that precision. Rendering converts to `f32`.
 
+use bevy::ecs::change_detection::{ContiguousComponentTicksMut, ContiguousMut};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
@@ -310,18 +311,26 @@ pub fn write_back_after<R: Send + 'static>(
     let mut written = 0;
     let (mut rest_circles, mut rest_velocities) = (&mut circles[..], &mut velocities[..]);
     if let Ok(tables) = balls.contiguous_iter_mut() {
-        for (table_entities, mut positions, mut table_velocities) in tables {
+        for (table_entities, positions, table_velocities) in tables {
             let places = written..written + table_entities.len();
             if entities.get(places.clone()) != Some(table_entities) {
                 break;
             }
+            let (positions, mut position_ticks) = in_place(positions);
+            let (table_velocities, mut velocity_ticks) = in_place(table_velocities);
+            let now = (position_ticks.this_run(), velocity_ticks.this_run());
             let pieces = positions
                 .chunks_mut(BALLS_PER_PIECE)
                 .zip(table_velocities.chunks_mut(BALLS_PER_PIECE))
+                .zip(position_ticks.changed_mut().chunks_mut(BALLS_PER_PIECE))
+                .zip(velocity_ticks.changed_mut().chunks_mut(BALLS_PER_PIECE))
                 .zip(take_front(&mut rest_circles, places.len()).chunks_mut(BALLS_PER_PIECE))
                 .zip(take_front(&mut rest_velocities, places.len()).chunks_mut(BALLS_PER_PIECE));
             results.extend(in_pieces(pieces.enumerate(), parallel, |(k, balls)| {
-                let (((positions, ball_velocities), circles), velocities) = balls;
+                let (
+                    ((((positions, ball_velocities), position_ticks), velocity_ticks), circles),
+                    velocities,
+                ) = balls;
                 let result = before(places.start + k * BALLS_PER_PIECE, (circles, velocities));
                 for (position, circle) in positions.iter_mut().zip(circles.iter()) {
                     position.0 = circle.center;
@@ -329,8 +338,12 @@ pub fn write_back_after<R: Send + 'static>(
                 for (velocity, &new) in ball_velocities.iter_mut().zip(velocities.iter()) {
                     velocity.0 = new;
                 }
+                position_ticks.fill(now.0);
+                velocity_ticks.fill(now.1);
                 result
             }));
+            mark_changed_by(&mut position_ticks);
+            mark_changed_by(&mut velocity_ticks);
             written = places.end;
         }
     }
@@ -343,6 +356,20 @@ pub fn write_back_after<R: Send + 'static>(
         }
     }
     results
+}
+
+/// A table's column as its values and its change ticks, for pieces that each write their
+/// values and mark their ticks changed: bevy's `DerefMut` would mark the whole column at
+/// once, on the calling thread (at 100,000 balls, work that kept the second thread idle).
+fn in_place<T>(column: ContiguousMut<'_, T>) -> (&mut [T], ContiguousComponentTicksMut<'_>) {
+    ContiguousMut::bypass_change_detection_split(column)
+}
+
+/// Where a column's values were changed, for builds that track it (bevy's `track_location`;
+/// nothing otherwise), as bevy's `DerefMut` records it.
+fn mark_changed_by(ticks: &mut ContiguousComponentTicksMut) {
+    let at = std::panic::Location::caller();
+    ticks.changed_by_mut().map(|changed_by| changed_by.fill(at));
 }
 
 #[cfg(test)]
@@ -387,6 +414,40 @@ mod tests {
         let balls = state.get(&world).expect("the balls' query");
         snapshot.fill_then(&balls, |_, _| ());
         assert_eq!(snapshot.held_when_filled, 0);
+    }
+
+    #[test]
+    fn every_ball_written_back_is_marked_changed() {
+        let mut world = World::new();
+        // Enough balls for the pool's pieces (`PARALLEL_MIN_BALLS`), each marking its own.
+        let count = 24_000;
+        let entities: Vec<Entity> = (0..count)
+            .map(|k| {
+                let state = BallState {
+                    position: DVec2::new(k as f64, 0.0),
+                    velocity: DVec2::ZERO,
+                    radius: 1.0,
+                };
+                world.spawn(ball_bundle(BallId(k), state)).id()
+            })
+            .collect();
+        let mut watcher: SystemState<(Query<(), Changed<Position>>, Query<(), Changed<Velocity>>)> =
+            SystemState::new(&mut world);
+        let mut changed = |world: &World| {
+            let (positions, velocities) = watcher.get(world).expect("the watcher's queries");
+            (positions.iter().count(), velocities.iter().count())
+        };
+        assert_eq!(changed(&world), (count as usize, count as usize), "spawned");
+        assert_eq!(changed(&world), (0, 0), "nothing since");
+        let mut circles: Vec<Circle> = (0..count)
+            .map(|k| Circle::new(DVec2::new(k as f64, 5.0), 1.0))
+            .collect();
+        let mut velocities = vec![DVec2::X; count as usize];
+        let mut state: SystemState<WrittenBalls> = SystemState::new(&mut world);
+        let mut balls = state.get_mut(&mut world).expect("the balls' query");
+        write_back(&entities, (&mut circles, &mut velocities), &mut balls);
+        assert_eq!(changed(&world), (count as usize, count as usize), "written");
+        assert_eq!(world.get::<Position>(entities[23_999]).unwrap().0.y, 5.0);
     }
 
     #[test]
