@@ -11,7 +11,7 @@ use crate::sim::geometry::circle::{Circle, circles_touch};
 /// How many candidates are tested at once.
 const RUN: usize = 32;
 
-/// The slots of a run found touching: one buffer for a whole search, since a fresh one for
+/// The places in a run found touching: one buffer for a whole search, since a fresh one for
 /// each ball's runs cost a tenth of the continuous mode's first search to clear.
 pub struct TouchingRuns {
     touching: [u32; RUN],
@@ -37,13 +37,15 @@ impl TouchingRuns {
         while start < slots.end {
             let end = (start + RUN).min(slots.end);
             let mut found = 0;
-            for (slot, &other) in (start..end).zip(&circles[start..end]) {
-                touching[found] = slot as u32;
+            for (offset, &other) in circles[start..end].iter().enumerate() {
+                // `found` is at most `offset`, so below `RUN`: the modulo only tells the
+                // compiler so, sparing a bounds check a candidate.
+                touching[found % RUN] = offset as u32;
                 found += usize::from(circles_touch(circle, other));
             }
             touching[..found]
                 .iter()
-                .for_each(|&slot| visit(slot as usize));
+                .for_each(|&offset| visit(start + offset as usize));
             start = end;
         }
     }
