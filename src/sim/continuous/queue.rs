@@ -20,8 +20,7 @@ pub struct ImpactQueue {
     next: usize,
     /// The impacts predicted since, by bucket of time.
     later: Buckets,
-    /// [`sort_in_buckets`]'s buffers, kept from step to step.
-    spare: Vec<Impact>,
+    /// Where each bucket of [`sort_in_buckets`] ends, kept from step to step.
     bucket_ends: Vec<u32>,
 }
 
@@ -29,13 +28,9 @@ impl ImpactQueue {
     /// Empties the queue and fills it with the step's first predictions; those predicted
     /// during the step will mostly lie within `horizon` seconds of its start.
     pub fn start(&mut self, impacts: impl Iterator<Item = Impact> + Clone, horizon: f64) {
-        self.sorted.clear();
-        // Exactly what is needed: the buffer is kept from step to step.
-        self.sorted.reserve_exact(impacts.clone().count());
-        self.sorted.extend(impacts);
-        let buckets = TimeBuckets::over(horizon, self.sorted.len() / IMPACTS_PER_SORTED_BUCKET);
-        let buffers = (&mut self.spare, &mut self.bucket_ends);
-        sort_in_buckets(&mut self.sorted, buckets, buffers);
+        let count = impacts.clone().count();
+        let buckets = TimeBuckets::over(horizon, count / IMPACTS_PER_SORTED_BUCKET);
+        sort_in_buckets(impacts, buckets, (&mut self.sorted, &mut self.bucket_ends));
         self.next = 0;
         self.later.start(horizon, self.sorted.len());
     }
@@ -184,23 +179,30 @@ impl TimeBuckets {
     }
 }
 
-/// Sorts `impacts` as `sort_unstable` does: spread over `buckets` by time (a counting sort,
-/// through `spare`; `bucket_ends` ends as each bucket's end), then each bucket sorted on its
+/// `impacts` into `sorted`, in the order of `sort_unstable`: dealt into `buckets` by time (a
+/// counting sort; `bucket_ends` ends as each bucket's end), then each bucket sorted on its
 /// own. Every impact in a bucket comes before every one in a later bucket, and with a few to
 /// a bucket each comparison of two `Impact`s, most of the cost, is spared all but a few times.
+/// `sorted` keeps its buffer, grown to exactly what is needed.
 fn sort_in_buckets(
-    impacts: &mut [Impact],
+    impacts: impl Iterator<Item = Impact> + Clone,
     buckets: TimeBuckets,
-    (spare, bucket_ends): (&mut Vec<Impact>, &mut Vec<u32>),
+    (sorted, bucket_ends): (&mut Vec<Impact>, &mut Vec<u32>),
 ) {
+    sorted.clear();
+    let Some(first) = impacts.clone().next() else {
+        return;
+    };
     if buckets.count == 1 {
-        impacts.sort_unstable();
+        sorted.reserve_exact(impacts.clone().count());
+        sorted.extend(impacts);
+        sorted.sort_unstable();
         return;
     }
     // Each bucket's size, then where it starts.
     bucket_ends.clear();
     bucket_ends.resize(buckets.count, 0);
-    for impact in impacts.iter() {
+    for impact in impacts.clone() {
         bucket_ends[buckets.of(impact.time)] += 1;
     }
     let mut start = 0;
@@ -208,16 +210,16 @@ fn sort_in_buckets(
         (start, *entry) = (start + *entry, start);
     }
     // Each impact to the next place in its bucket: each entry moves on to its bucket's end.
-    spare.clear();
-    spare.extend_from_slice(impacts);
-    for &impact in spare.iter() {
+    sorted.reserve_exact(start as usize);
+    sorted.resize(start as usize, first);
+    for impact in impacts {
         let next = &mut bucket_ends[buckets.of(impact.time)];
-        impacts[*next as usize] = impact;
+        sorted[*next as usize] = impact;
         *next += 1;
     }
     let mut start = 0;
     for &end in bucket_ends.iter() {
-        impacts[start..end as usize].sort_unstable();
+        sorted[start..end as usize].sort_unstable();
         start = end as usize;
     }
 }
@@ -312,7 +314,7 @@ mod tests {
             5..=20 => (k % 7) as f64 / 420.0,
             _ => rng.random_range(0.0..1.0 / 60.0),
         };
-        let (mut spare, mut ends) = (Vec::new(), Vec::new());
+        let (mut sorted, mut ends) = (Vec::new(), Vec::new());
         for count in [0, 1, 7, 1000, 5000] {
             let impacts: Vec<Impact> = (0..count)
                 .map(|k| {
@@ -323,9 +325,8 @@ mod tests {
             let mut expected = impacts.clone();
             expected.sort_unstable();
             for buckets in [1, 3, count / IMPACTS_PER_SORTED_BUCKET, 4 * count] {
-                let mut sorted = impacts.clone();
                 let by_time = TimeBuckets::over(1.0 / 60.0, buckets);
-                sort_in_buckets(&mut sorted, by_time, (&mut spare, &mut ends));
+                sort_in_buckets(impacts.iter().copied(), by_time, (&mut sorted, &mut ends));
                 // `Debug` tells NaN times apart, where `==` would not.
                 assert_eq!(
                     format!("{sorted:?}"),
