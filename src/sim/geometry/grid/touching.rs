@@ -1,8 +1,8 @@
 //! The exact test on a run of candidates without a branch per candidate:
 //! [`TouchingRuns::for_each_touching`]. Most of a grid's candidates do not touch, and which do
 //! is a matter of chance, so a branch on each test mispredicts often; testing a run of them
-//! first, writing every candidate's slot and keeping it only if it touches, leaves one loop
-//! whose branches are predictable and a short one over the few that touch.
+//! first, writing every candidate's place in the run and keeping it only if it touches, leaves
+//! one loop whose branches are predictable and a short one over the few that touch.
 
 use std::ops::Range;
 
