@@ -13,10 +13,21 @@ use crate::sim::geometry::wall::Wall;
 /// for the parabola's bulge from it (`|g|·T²/8`). Without gravity, the smallest such circle.
 #[inline]
 pub fn swept_circle(circle: Circle, velocity: DVec2, gravity: DVec2, seconds: f64) -> Circle {
+    swept_circle_under(circle, velocity, (gravity, gravity.length()), seconds)
+}
+
+/// [`swept_circle`] with gravity's length given: the same circle to the bit.
+#[inline]
+pub fn swept_circle_under(
+    circle: Circle,
+    velocity: DVec2,
+    (gravity, gravity_length): (DVec2, f64),
+    seconds: f64,
+) -> Circle {
     let half = 0.5 * seconds;
     Circle::new(
         circle.center + velocity * half + gravity * (half * half),
-        circle.radius + velocity.length() * half + gravity.length() * (1.5 * half * half),
+        circle.radius + velocity.length() * half + gravity_length * (1.5 * half * half),
     )
 }
 
