@@ -38,14 +38,12 @@ impl Timeline {
         let dt = spec.dt;
         // The grid makes each swept circle three times (its extent, its cells, its gather):
         // gravity's length, a square root, is taken once for the step (−3% at 100,000 balls).
-        let gravity = (spec.gravity, spec.gravity.length());
+        // A new mover accelerates at gravity, or not at all if still.
+        let gravity_length = spec.gravity.length();
         self.grid.rebuild_with(circles.len(), |ball| {
             let mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
-            let accel = if mover.still {
-                (DVec2::ZERO, 0.0)
-            } else {
-                gravity
-            };
+            let accel_length = if mover.still { 0.0 } else { gravity_length };
+            let accel = (mover.accel, accel_length);
             swept_circle_under(mover.circle(), mover.moving_velocity(), accel, dt)
         });
         // From here on every ball is known by its slot in the grid's cell order.

@@ -193,12 +193,6 @@ fn sort_in_buckets(
     let Some(first) = impacts.clone().next() else {
         return;
     };
-    if buckets.count == 1 {
-        sorted.reserve_exact(impacts.clone().count());
-        sorted.extend(impacts);
-        sorted.sort_unstable();
-        return;
-    }
     // Each bucket's size, then where it starts.
     bucket_ends.clear();
     bucket_ends.resize(buckets.count, 0);
