@@ -10,6 +10,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::geometry::Circle;
+use super::geometry::circle::RadiusRange;
 use super::parallel::{BALLS_PER_PIECE, in_pieces, piece_ranges, take_front, worth_splitting};
 
 /// Marks a simulated ball; spawning it brings the state components along.
@@ -127,6 +128,8 @@ pub struct BallSnapshot {
     /// How many balls were held when the movement stage filled the snapshot, as their
     /// [`Rest`] said: the count the response's releases do not change.
     pub held_when_filled: usize,
+    /// The smallest and largest radius among the balls, as filled.
+    pub radii: RadiusRange,
 }
 
 impl BallSnapshot {
@@ -149,12 +152,13 @@ impl BallSnapshot {
         let mut rest = self.columns_for(count);
         let Ok(tables) = balls.contiguous_iter() else {
             // Not stored in tables: one ball at a time, then all as one piece.
-            let mut held = 0;
+            let (mut held, mut radii) = (0, RadiusRange::NONE);
             for (entity, position, velocity, radius, rest_state) in balls {
                 let ball = ([entity], [*position], [*velocity], [*radius], [*rest_state]);
-                held += rest.take_front(1).copy_from(ball);
+                held += rest.take_front(1).copy_from(ball).0;
+                radii = radii.with(radius.0);
             }
-            self.held_when_filled = held;
+            (self.held_when_filled, self.radii) = (held, radii);
             let all = (
                 &mut self.circles[..],
                 &mut self.velocities[..],
@@ -171,7 +175,7 @@ impl BallSnapshot {
             let pieces = rest.take_front(len).into_pieces().zip(piece_ranges(len));
             results.extend(in_pieces(pieces, parallel, |(mut into, balls)| {
                 let (entities, positions, velocities, radii, rests) = table;
-                let held = into.copy_from((
+                let filled = into.copy_from((
                     &entities[balls.clone()],
                     &positions[balls.clone()],
                     &velocities[balls.clone()],
@@ -179,11 +183,13 @@ impl BallSnapshot {
                     &rests[balls.clone()],
                 ));
                 let piece = (into.circles, into.velocities, into.held);
-                (held, then(first + balls.start, piece))
+                (filled, then(first + balls.start, piece))
             }));
             first += len;
         }
-        self.held_when_filled = results.iter().map(|(held, _)| held).sum();
+        self.held_when_filled = results.iter().map(|((held, _), _)| held).sum();
+        self.radii = (results.iter().map(|&((_, radii), _)| radii))
+            .fold(RadiusRange::NONE, RadiusRange::joined);
         results.into_iter().map(|(_, result)| result).collect()
     }
 
@@ -232,7 +238,8 @@ impl<'a> Columns<'a> {
         })
     }
 
-    /// Copies in the same number of balls from a table's columns; returns how many are held.
+    /// Copies in the same number of balls from a table's columns; returns how many are held,
+    /// and their radii's range.
     fn copy_from(
         &mut self,
         (entities, positions, velocities, radii, rests): (
@@ -242,7 +249,7 @@ impl<'a> Columns<'a> {
             impl AsRef<[Radius]>,
             impl AsRef<[Rest]>,
         ),
-    ) -> usize {
+    ) -> (usize, RadiusRange) {
         self.entities.copy_from_slice(entities.as_ref());
         let places = self
             .circles
@@ -260,7 +267,10 @@ impl<'a> Columns<'a> {
             *held = rest.is_held();
             held_count += usize::from(*held);
         }
-        held_count
+        (
+            held_count,
+            RadiusRange::of_each(radii.as_ref(), |radius| radius.0),
+        )
     }
 }
 

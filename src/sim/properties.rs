@@ -8,7 +8,7 @@
 use bevy::math::DVec2;
 use proptest::prelude::*;
 
-use super::continuous::{StepSpec, Timeline};
+use super::continuous::{MIN_HITS_PER_BALL, StepSpec, Timeline};
 use super::geometry::circle::{
     Circle, circle_contact, circles_touch, collision_point, time_of_impact,
 };
@@ -297,7 +297,7 @@ proptest! {
         e in restitution(),
         dt in prop_oneof![Just(1.0 / 60.0), 0.001..0.2f64],
     ) {
-        let spec = StepSpec { dt, half: DVec2::new(200.0, 50.0), restitution: e, mass_model: model, gravity: DVec2::ZERO, rest_speed: 0.0 };
+        let spec = StepSpec { dt, half: DVec2::new(200.0, 50.0), restitution: e, mass_model: model, gravity: DVec2::ZERO, rest_speed: 0.0, hit_limit: MIN_HITS_PER_BALL };
         let energy = |c: &[Circle], v: &[DVec2]| -> f64 {
             c.iter().zip(v).map(|(c, v)| 0.5 * model.mass(c.radius) * v.length_squared()).sum()
         };

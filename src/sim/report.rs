@@ -137,7 +137,7 @@ pub struct StepLog {
     pub contact_count: u64,
     drop_contacts: bool,
     /// A continuous step stopped handling impacts for some ball (see
-    /// [`MAX_HITS_PER_BALL`](super::continuous::MAX_HITS_PER_BALL)).
+    /// [`hit_limit`](super::continuous::hit_limit)).
     pub cut_short: bool,
     /// The walls' impulse on resting balls (stops, the resting solver's contacts, sleeping
     /// balls' weight): no hits, but part of the pressure. Mass x pixels per second.

@@ -43,7 +43,7 @@ use crate::sim::clock::SimClock;
 use crate::sim::params::SimParams;
 use crate::sim::report::{ContactPoint, Hit, StepLog};
 pub use bands::Bands;
-pub use state::{MAX_HITS_PER_BALL, StepSpec, Timeline};
+pub use state::{MAX_HITS_PER_BALL, MIN_HITS_PER_BALL, StepSpec, Timeline, hit_limit};
 
 /// Stage 2: every impact of the coming step that the balls' paths lead to.
 pub fn predict_impacts(
@@ -56,7 +56,7 @@ pub fn predict_impacts(
     if snapshot.all_held() {
         return; // nothing flies: `run_timeline` has nothing to do either
     }
-    let spec = StepSpec::new(&params, clock.dt);
+    let spec = StepSpec::new(&params, clock.dt, snapshot.radii);
     bands.predict_step(
         &mut timeline,
         &snapshot.circles,
@@ -79,7 +79,7 @@ pub fn run_timeline(
     if snapshot.all_held() {
         return;
     }
-    let spec = StepSpec::new(&params, clock.dt);
+    let spec = StepSpec::new(&params, clock.dt, snapshot.radii);
     let BallSnapshot {
         entities,
         circles,

@@ -28,7 +28,7 @@ pub struct Paths {
     far_limit: f64,
     /// The paths kept apart: big balls' and far-reaching ones. Stale entries stay until the
     /// step ends (skipped by their hit count); a ball takes at most
-    /// [`MAX_HITS_PER_BALL`](super::state::MAX_HITS_PER_BALL) paths a step, and few reach far.
+    /// [`hit_limit`](super::state::hit_limit) paths a step, and few reach far.
     far: Vec<FarPath>,
 }
 

@@ -7,14 +7,14 @@ use super::impact::{Impact, Party};
 use super::predict::{SWEPT_MARGIN, pair_time, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
-use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
+use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circles_touch};
 
 impl Timeline {
     /// Queues the next wall and ball impacts of the ball in `slot`, whose velocity changed
     /// at `now`.
     pub(super) fn predict_for(&mut self, slot: usize, now: f64, spec: StepSpec) {
-        if self.movers[slot].hits == MAX_HITS_PER_BALL {
+        if self.movers[slot].hits == spec.hit_limit {
             // No more impacts for this ball this step: the end-of-step fallback takes over.
             self.cut_short = true;
             self.paths.end(&mut self.grid, slot as u32);
@@ -43,7 +43,7 @@ impl Timeline {
     /// as it is found ([`prefetch_mover`]), and timed after: their loads overlap (at a
     /// million balls the movers lie well past the cache: −3% there, −1% at 100,000).
     pub(super) fn predict_for_both(&mut self, (a, b): (usize, usize), now: f64, spec: StepSpec) {
-        let spent = |slot: usize| self.movers[slot].hits == MAX_HITS_PER_BALL;
+        let spent = |slot: usize| self.movers[slot].hits == spec.hit_limit;
         if spent(a) || spent(b) {
             self.predict_for(a, now, spec);
             self.predict_for(b, now, spec);
@@ -184,7 +184,7 @@ mod tests {
                 impact.wall().is_none()
                     && timeline.movers[a].hits == impact.hits_a
                     && timeline.movers[b].hits == impact.hits_other
-                    && impact.hits_other < MAX_HITS_PER_BALL
+                    && impact.hits_other < spec.hit_limit
             };
             if !current(&both) {
                 continue;
@@ -200,7 +200,7 @@ mod tests {
                 (movers[a].velocity, movers[b].velocity) = (new[0], new[1]);
                 movers[a].hits += 1;
                 movers[b].hits = if redirected.is_multiple_of(5) {
-                    MAX_HITS_PER_BALL
+                    spec.hit_limit
                 } else {
                     movers[b].hits + 1
                 };

@@ -11,18 +11,35 @@ use super::impact::Prediction;
 use super::paths::Paths;
 use super::queue::ImpactQueue;
 use crate::sim::geometry::Circle;
+use crate::sim::geometry::circle::RadiusRange;
 use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::{FoundInBands, IndexedContact};
 use crate::sim::params::{MassModel, SimParams};
 use crate::sim::resting::rest_speed;
 
-/// A ball takes at most this many hits in one step. Only an inelastic collapse (a pile
-/// pressed together by gravity, restitution below 1) comes near it; the step then ends for
-/// that ball without further impacts, and the overlaps left at the end get the discrete
-/// mode's response. [`SimStats::cut_short_steps`](crate::sim::SimStats::cut_short_steps)
-/// counts such steps.
-pub const MAX_HITS_PER_BALL: u32 = 16;
+/// The fewest hits a ball may take in one step ([`hit_limit`]).
+pub const MIN_HITS_PER_BALL: u32 = 16;
+
+/// The most hits a ball may take in one step, whatever the masses ([`hit_limit`]): it bounds
+/// what an inelastic collapse costs a step.
+pub const MAX_HITS_PER_BALL: u32 = 1024;
+
+/// How many hits a ball may take in one step when the heaviest ball is `mass_ratio` times
+/// the lightest. A light ball caught between a heavy one and a wall (or a crowd) is struck
+/// about π√(M/m) times while the heavy one turns back (Galperin's billiards: 31 times for a
+/// ratio of 100, 314 for 10,000), so the limit is twice that, and never under
+/// [`MIN_HITS_PER_BALL`] (16, what any ratio up to 6.4 gets: the standard gas's is 3), nor
+/// over [`MAX_HITS_PER_BALL`] (a ratio past 26,500). Otherwise only an inelastic collapse
+/// (balls pressed together with restitution below 1, impacts repeating ever faster) goes past
+/// it: the step then ends for that ball without further impacts, and the overlaps left at the
+/// end get the discrete mode's response.
+/// [`SimStats::cut_short_steps`](crate::sim::SimStats::cut_short_steps) counts such steps.
+pub fn hit_limit(mass_ratio: f64) -> u32 {
+    let chain = (2.0 * std::f64::consts::PI * mass_ratio.sqrt()).ceil();
+    // A NaN ratio gives 0 (`as` saturates): the fewest.
+    (chain as u32).clamp(MIN_HITS_PER_BALL, MAX_HITS_PER_BALL)
+}
 
 /// What a step's timeline needs of the simulation's parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,10 +56,14 @@ pub struct StepSpec {
     /// Impacts closing slower than this, pixels per second, do not bounce: the resting rule
     /// ([`rest_speed`]).
     pub rest_speed: f64,
+    /// Hits a ball may take in the step ([`hit_limit`]).
+    pub hit_limit: u32,
 }
 
 impl StepSpec {
-    pub fn new(params: &SimParams, dt: f64) -> Self {
+    /// The step of `dt` seconds for balls whose radii span `radii`.
+    pub fn new(params: &SimParams, dt: f64, radii: RadiusRange) -> Self {
+        let mass = |radius| params.mass_model.mass(radius);
         Self {
             dt,
             half: params.half_extents(),
@@ -50,6 +71,7 @@ impl StepSpec {
             mass_model: params.mass_model,
             gravity: params.gravity,
             rest_speed: rest_speed(params, dt),
+            hit_limit: hit_limit(mass(radii.largest) / mass(radii.smallest)),
         }
     }
 }
@@ -66,6 +88,7 @@ impl StepSpec {
             mass_model: MassModel::Radius,
             gravity,
             rest_speed: 0.0,
+            hit_limit: MIN_HITS_PER_BALL,
         }
     }
 }
@@ -194,7 +217,7 @@ pub struct Timeline {
     /// Whether every ball the last run moved to the end of the step lay inside the walls
     /// then (`lies_inside`), so that only the balls moved since may need containing.
     pub(super) ends_inside: bool,
-    /// Whether some ball in the last run reached [`MAX_HITS_PER_BALL`].
+    /// Whether some ball in the last run reached its hits for the step ([`hit_limit`]).
     pub cut_short: bool,
     /// The walls' impulse on balls that stopped against them by the resting rule in the last
     /// run, mass x pixels per second: pressure, not hits.
@@ -223,6 +246,31 @@ impl Timeline {
         hits.resize(self.order.len(), 0);
         for (mover, &index) in self.movers.iter().zip(&self.order) {
             hits[index as usize] = mover.hits;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_hit_limit_covers_twice_a_light_ball_s_chain_of_hits_between_a_heavy_one_and_a_wall() {
+        // Up to a ratio of 6.4 (the standard gas's is 3), the fewest.
+        for ratio in [1.0, 3.0, 6.4] {
+            assert_eq!(hit_limit(ratio), MIN_HITS_PER_BALL, "ratio {ratio}");
+        }
+        // Galperin's 31 hits for a ratio of 100, 314 for 10,000: twice π√ratio, rounded up.
+        assert_eq!(hit_limit(100.0), 63);
+        assert_eq!(hit_limit(10_000.0), 629);
+        // The mixed scene's radius-40 balls among radius-1.2 ones, mass = radius.
+        assert_eq!(hit_limit(40.0 / 1.2), 37);
+        // Past any ratio a step can afford, and for no ratio at all, the bounds.
+        for ratio in [1e6, f64::INFINITY] {
+            assert_eq!(hit_limit(ratio), MAX_HITS_PER_BALL, "ratio {ratio}");
+        }
+        for ratio in [0.5, 0.0, f64::NAN] {
+            assert_eq!(hit_limit(ratio), MIN_HITS_PER_BALL, "ratio {ratio}");
         }
     }
 }

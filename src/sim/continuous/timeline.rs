@@ -16,7 +16,7 @@
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Prediction};
-use super::state::{MAX_HITS_PER_BALL, Mover, StepSpec, Timeline};
+use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, circle_contact, collision_point, contact_normal};
 use crate::sim::geometry::contain::{contain_all, lies_inside};
 use crate::sim::geometry::impulse::{normal_exchange, resolve_overlaps, separate};
@@ -69,7 +69,7 @@ impl Timeline {
             if prefetching {
                 self.prefetch_coming();
             }
-            if !self.is_current(&impact) {
+            if !self.is_current(&impact, spec.hit_limit) {
                 continue;
             }
             // An impact predicted for the very moment of the one that redirected its ball can
@@ -129,8 +129,8 @@ impl Timeline {
     }
 
     /// Whether `impact` still holds: neither ball has been hit since it was predicted, and
-    /// neither has used up its hits for the step (which cuts the step short).
-    fn is_current(&mut self, impact: &Impact) -> bool {
+    /// neither has used up its `hit_limit` hits for the step (which cuts the step short).
+    fn is_current(&mut self, impact: &Impact, hit_limit: u32) -> bool {
         let hits_a = self.movers[impact.a as usize].hits;
         let hits_other = match impact.wall() {
             Some(_) => 0,
@@ -139,7 +139,7 @@ impl Timeline {
         if hits_a != impact.hits_a || hits_other != impact.hits_other {
             return false; // stale: a ball in it has been hit since
         }
-        if hits_a == MAX_HITS_PER_BALL || hits_other == MAX_HITS_PER_BALL {
+        if hits_a == hit_limit || hits_other == hit_limit {
             self.cut_short = true;
             return false;
         }
@@ -416,6 +416,7 @@ fn contain_at_the_end(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::continuous::MIN_HITS_PER_BALL;
     use crate::sim::params::MassModel;
 
     #[test]
@@ -427,6 +428,7 @@ mod tests {
             mass_model: MassModel::Radius,
             gravity: DVec2::ZERO,
             rest_speed: 0.0,
+            hit_limit: MIN_HITS_PER_BALL,
         };
         let mut circles = vec![
             Circle::new(DVec2::new(-100.0, 0.0), 5.0),

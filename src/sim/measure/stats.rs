@@ -13,7 +13,7 @@ pub struct SimStats {
     /// Sum of the walls' normal impulses on the balls, mass x pixels per second.
     pub wall_impulse: f64,
     /// Continuous steps that reached their hit budget and finished without handling every
-    /// impact (see [`MAX_HITS_PER_BALL`](crate::sim::continuous::MAX_HITS_PER_BALL)).
+    /// impact (see [`hit_limit`](crate::sim::continuous::hit_limit)).
     pub cut_short_steps: u64,
     /// Contact points recorded (discrete mode: touching pairs found; continuous mode:
     /// ball–ball impacts), summed over the steps.
