@@ -61,16 +61,24 @@ impl Timeline {
         let (end, balls) = (spec.dt, (movers.as_slice(), order.as_slice()));
         let found = &mut self.found;
         found.clear();
+        // The two balls find themselves and each other: only `b` finding `a` is timed (as the
+        // call for `b` alone would), and apart, so that neither is listed or loaded again.
+        let mut b_finds_a = false;
         self.paths
             .for_each_that_may_touch_any(&self.grid, swept, hits_of, |k, other| {
+                if other as usize == a || other as usize == b {
+                    b_finds_a |= k == 1 && other as usize == a;
+                    return;
+                }
                 prefetch_mover(movers, other);
                 found.push((k as u8, other));
             });
         for &(k, other) in found.iter() {
-            let (slot, other) = ([a, b][k as usize], other as usize);
-            if (slot, other) != (a, b) {
-                queue_pair_impact(balls, (slot, other), now, end, queue);
-            }
+            let slot = [a, b][k as usize];
+            queue_pair_impact(balls, (slot, other as usize), now, end, queue);
+        }
+        if b_finds_a {
+            queue_pair_impact(balls, (b, a), now, end, queue);
         }
         if a_finds_b {
             queue_pair_impact(balls, (a, b), now, end, queue);
