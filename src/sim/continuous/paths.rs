@@ -11,7 +11,7 @@
 use bevy::math::DVec2;
 
 use crate::sim::geometry::Circle;
-use crate::sim::geometry::circle::circles_touch;
+use crate::sim::geometry::circle::within_reach;
 use crate::sim::geometry::grid::UniformGrid;
 
 /// How far each ball's current path reaches, and the paths kept apart. The current paths of
@@ -127,7 +127,7 @@ impl Paths {
         // Big balls on their first path, through their own grid; then the paths kept apart.
         for (k, &probe) in swept.iter().enumerate() {
             grid.for_each_big_that_may_touch(probe, |slot, circle| {
-                if circles_touch(probe, circle) && hits_of(slot) == 0 {
+                if within_reach(probe, circle) && hits_of(slot) == 0 {
                     visit(k, slot);
                 }
             });
@@ -150,7 +150,7 @@ fn visit_touching<const N: usize>(
     visit: &mut impl FnMut(usize, u32),
 ) {
     for (k, &probe) in swept.iter().enumerate() {
-        if circles_touch(probe, circle) {
+        if within_reach(probe, circle) {
             visit(k, slot);
         }
     }

@@ -14,7 +14,7 @@ use bevy::math::DVec2;
 
 use super::impact::{Impact, Party, Prediction, approach_time, swept_circle, swept_circle_under};
 use super::state::{Mover, StepSpec, Timeline};
-use crate::sim::geometry::circle::{Circle, circles_touch, overlapping};
+use crate::sim::geometry::circle::{Circle, overlapping, within_reach};
 use crate::sim::geometry::flight::time_to_touch;
 use crate::sim::geometry::pairs::search_in_bands;
 use crate::sim::geometry::wall::wall_time_of_impact;
@@ -91,12 +91,12 @@ impl Timeline {
     }
 
     /// Every pair's impact, through the pairs of swept circles the grid finds touching (the
-    /// swept circles bound the paths: if they do not touch, the balls cannot), in parallel
-    /// bands for many balls.
+    /// swept circles bound the paths: if they do not touch, the balls cannot), by their
+    /// distance alone ([`within_reach`]), in parallel bands for many balls.
     fn predict_every_pair(&mut self, dt: f64) {
         let (movers, order) = (&self.movers, &self.order);
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
-            grid.for_each_touching_pair_in_rows(rows, |i, j, _, _| {
+            grid.for_each_pair_within_reach_in_rows(rows, |i, j, _, _| {
                 let (a, b) = (i.min(j), i.max(j));
                 predict_pair((movers, order), (a, b), dt, found);
             });
@@ -128,7 +128,7 @@ impl Timeline {
                     // A pair of flying balls is taken from the one of lower index.
                     if other == slot
                         || (!movers[other].still && order[other] < order[slot])
-                        || !circles_touch(own, other_swept)
+                        || !within_reach(own, other_swept)
                     {
                         return;
                     }

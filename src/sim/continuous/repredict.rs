@@ -8,7 +8,7 @@ use super::predict::{SWEPT_MARGIN, pair_time, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
 use super::state::{Mover, StepSpec, Timeline};
-use crate::sim::geometry::circle::{Circle, circles_touch};
+use crate::sim::geometry::circle::{Circle, within_reach};
 
 impl Timeline {
     /// Queues the next wall and ball impacts of the ball in `slot`, whose velocity changed
@@ -54,7 +54,7 @@ impl Timeline {
         // `b`'s path until now is found in its cell (one kept apart, or a big ball's, is
         // stale by its hits since this impact).
         let a_finds_b =
-            b < self.grid.small_count() && circles_touch(swept[0], self.grid.circle_in_slot(b));
+            b < self.grid.small_count() && within_reach(swept[0], self.grid.circle_in_slot(b));
         self.take_new_path(b, swept[1], now, spec);
         let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
         let hits_of = |other: u32| movers[other as usize].hits;

@@ -4,10 +4,10 @@
 //! continuous mode the circles they sweep over the step, and also queries around a circle).
 //! Two methods find the same pairs: [`UniformGrid`] (`uniform.rs`), O(N), the default, with
 //! its first pass over the balls in `extent.rs`, its counting sort in `counting.rs`, its
-//! queries around a place in `queries.rs`, its cells' geometry in `cells.rs`, its test of a
-//! run of candidates at once in `touching.rs` and the few big balls kept apart by rows in
-//! `rows.rs`; and [`for_each_pair`], O(N^2), kept as the reference the grid is tested
-//! against.
+//! queries around a place in `queries.rs`, its cells' geometry in `cells.rs`, its pair search
+//! (each ball's candidates, a run of them tested at once) in `touching.rs` and the few big
+//! balls kept apart by rows in `rows.rs`; and [`for_each_pair`], O(N^2), kept as the
+//! reference the grid is tested against.
 
 mod cells;
 mod counting;

@@ -5,7 +5,7 @@
 //! `BIG_RADIUS_FACTOR` (4) times the mean is big: it stays out of the cells and goes into a
 //! grid of its own (and so on down, a hierarchy), so a few big balls among many small ones do
 //! not make every cell big. Each big ball is paired with the small balls in the cells its
-//! circle reaches, row by row ([`RowLists`]).
+//! circle reaches, row by row ([`RowLists`]); the pairs themselves are found in `touching.rs`.
 
 use bevy::math::DVec2;
 
@@ -13,7 +13,6 @@ use super::cells::CellMap;
 use super::counting::{NO_CELL, cells_of_slots, sort_bands, sort_into_cells};
 use super::extent::Extent;
 use super::rows::RowLists;
-use super::touching::TouchingRuns;
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
     BALLS_PER_PIECE, carve, in_pieces, piece_ranges, split_evenly, threads_at_work, worth_splitting,
@@ -50,7 +49,7 @@ pub struct UniformGrid {
     big: Option<Box<UniformGrid>>,
     /// For each row of cells, the big balls (by that order) whose circle, grown by
     /// `small_reach`, reaches into it.
-    big_rows: RowLists,
+    pub(super) big_rows: RowLists,
 }
 
 /// Whether a ball of `radius` is big where the limit is `big_limit`. A NaN is not big.
@@ -249,106 +248,6 @@ impl UniformGrid {
     /// grid's cells keeps those apart too.
     pub fn big_limit(&self) -> f64 {
         self.big_limit
-    }
-
-    /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls whose circles
-    /// touch: the candidates, pairs in the same or adjacent cells and pairs with a big ball
-    /// whose circles' boxes might meet, put through the exact test a run at a time
-    /// (`touching.rs`). In a fixed order: the big balls' own pairs first, then row by row.
-    /// Indices are the positions in the slice given to [`rebuild`](Self::rebuild).
-    pub fn for_each_touching_pair(&self, visit: impl FnMut(u32, u32, Circle, Circle)) {
-        self.for_each_touching_pair_in_rows(0..self.rows(), visit);
-    }
-
-    /// The pairs [`for_each_touching_pair`](Self::for_each_touching_pair) visits from the
-    /// cells of `rows`, in the same order (the big balls' own pairs with the first row).
-    /// Disjoint row ranges visit disjoint pairs, so bands of rows can be searched in parallel
-    /// and their results joined in row order.
-    pub fn for_each_touching_pair_in_rows(
-        &self,
-        rows: std::ops::Range<usize>,
-        mut visit: impl FnMut(u32, u32, Circle, Circle),
-    ) {
-        // With the band that holds the first row (a band may be empty: more bands than rows).
-        if rows.contains(&0) {
-            self.visit_big_pairs(&mut visit);
-        }
-        // In row-major order a cell and its right neighbour are adjacent, and the three cells
-        // above (left, centre, right) are one contiguous run: each ball's candidates are two
-        // contiguous slot ranges, the rest of its own cell with the right cell, and the run
-        // above, each tested without a branch per candidate.
-        let columns = self.cells.columns;
-        let mut runs = TouchingRuns::new();
-        for row in rows {
-            for column in 0..columns {
-                let cell = row * columns + column;
-                let (start, end) = (
-                    self.cell_start[cell] as usize,
-                    self.cell_start[cell + 1] as usize,
-                );
-                if start == end {
-                    continue;
-                }
-                let same_row_end =
-                    self.cell_start[cell + usize::from(column + 1 < columns) + 1] as usize;
-                let above = if row + 1 < self.cells.rows {
-                    let first = cell + columns - usize::from(column > 0);
-                    let last = cell + columns + usize::from(column + 1 < columns);
-                    self.cell_start[first] as usize..self.cell_start[last + 1] as usize
-                } else {
-                    0..0
-                };
-                for slot in start..end {
-                    let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-                    for range in [slot + 1..same_row_end, above.clone()] {
-                        runs.for_each_touching(circle, range, &self.sorted_circle, |other| {
-                            visit(
-                                index,
-                                self.sorted_index[other],
-                                circle,
-                                self.sorted_circle[other],
-                            );
-                        });
-                    }
-                }
-            }
-            if self.big_grid().is_some() {
-                self.visit_big_with_small_in_row(row, &mut runs, &mut visit);
-            }
-        }
-    }
-
-    /// The pairs of two big balls, through their own grid.
-    fn visit_big_pairs(&self, visit: &mut dyn FnMut(u32, u32, Circle, Circle)) {
-        if let Some(big) = self.big_grid() {
-            let index = |k: u32| self.sorted_index[self.small_count + k as usize];
-            big.for_each_touching_pair(|i, j, a, b| visit(index(i), index(j), a, b));
-        }
-    }
-
-    /// Each big ball that reaches `row` with every ball it touches in the cells of `row` it
-    /// reaches.
-    fn visit_big_with_small_in_row(
-        &self,
-        row: usize,
-        runs: &mut TouchingRuns,
-        visit: &mut impl FnMut(u32, u32, Circle, Circle),
-    ) {
-        for &k in self.big_rows.in_row(row) {
-            let slot = self.small_count + k as usize;
-            let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-            let ((first, _), (last, _)) = self.cells.corners_reached(circle, self.small_reach);
-            let start = row * self.cells.columns;
-            let slots = self.slots_of(start + first..start + last + 1);
-            runs.for_each_touching(circle, slots, &self.sorted_circle, |other| {
-                visit(
-                    index,
-                    self.sorted_index[other],
-                    circle,
-                    self.sorted_circle[other],
-                );
-            });
-        }
     }
 
     /// The slots of the balls in the consecutive cells `cells` (the cells hold the slots
