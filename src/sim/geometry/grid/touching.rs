@@ -3,21 +3,23 @@
 //! that test made on a run of candidates without a branch per candidate
 //! ([`TouchingRuns::for_each_touching`]). Most of a grid's candidates do not touch, and which
 //! do is a matter of chance, so a branch on each test mispredicts often; testing a run of them
-//! first, writing every candidate's place in the run and keeping it only if it touches, leaves
-//! one loop whose branches are predictable and a short one over the few that touch. The test
-//! is the caller's: the narrow phase's `circles_touch` (AABB, then distance), or the distance
-//! alone (`within_reach`) for the continuous mode's swept circles.
+//! first, writing every candidate's slot and keeping it only if it touches, leaves one loop
+//! whose branches are predictable and a short one over the few that touch. The test is the
+//! caller's: the narrow phase's `circles_touch` (AABB, then distance), or the distance alone
+//! (`within_reach`) for the continuous mode's swept circles.
 
 use std::ops::Range;
 
 use super::uniform::UniformGrid;
 use crate::sim::geometry::circle::{Circle, circles_touch, within_reach};
 
-/// How many candidates are tested at once.
+/// How many touching slots the buffer holds: candidates are tested half as many at a time, so
+/// that what a chunk finds fits beside what the chunks before it found, until they are
+/// visited.
 const RUN: usize = 32;
 
-/// The places in a run found touching: one buffer for a whole search, since a fresh one for
-/// each ball's runs cost a tenth of the continuous mode's first search to clear.
+/// The slots found touching: one buffer for a whole search, since a fresh one for each ball's
+/// runs cost a tenth of the continuous mode's first search to clear.
 pub struct TouchingRuns {
     touching: [u32; RUN],
 }
@@ -35,24 +37,51 @@ impl TouchingRuns {
         (circle, touch): (Circle, impl Fn(Circle, Circle) -> bool),
         slots: Range<usize>,
         circles: &[Circle],
+        visit: impl FnMut(usize),
+    ) {
+        self.for_each_touching_in((circle, touch), [slots], circles, visit);
+    }
+
+    /// [`for_each_touching`](Self::for_each_touching) over each range of `ranges` in turn,
+    /// with one pass over the slots found in them all (unless they are many): a ball's two
+    /// runs of candidates in the grid, the rest of its row and the row above, so that each
+    /// ball takes one short loop over what it found, not two (−1.3% of the continuous
+    /// step's instructions, −1.0% of the discrete one's).
+    #[inline]
+    pub fn for_each_touching_in<const R: usize>(
+        &mut self,
+        (circle, touch): (Circle, impl Fn(Circle, Circle) -> bool),
+        ranges: [Range<usize>; R],
+        circles: &[Circle],
         mut visit: impl FnMut(usize),
     ) {
+        const CHUNK: usize = RUN / 2;
         let touching = &mut self.touching;
-        let mut start = slots.start;
-        while start < slots.end {
-            let end = (start + RUN).min(slots.end);
-            let mut found = 0;
-            for (offset, &other) in circles[start..end].iter().enumerate() {
-                // `found` is at most `offset`, so below `RUN`: the modulo only tells the
-                // compiler so, sparing a bounds check a candidate.
-                touching[found % RUN] = offset as u32;
-                found += usize::from(touch(circle, other));
+        let mut found = 0;
+        for range in ranges {
+            let mut start = range.start;
+            while start < range.end {
+                // At most `CHUNK` found before a chunk of at most `CHUNK`: the buffer holds
+                // them all.
+                if found > CHUNK {
+                    touching[..found]
+                        .iter()
+                        .for_each(|&slot| visit(slot as usize));
+                    found = 0;
+                }
+                let end = (start + CHUNK).min(range.end);
+                for (slot, &other) in (start..end).zip(&circles[start..end]) {
+                    // `found` is below `RUN`: the modulo only tells the compiler so, sparing
+                    // a bounds check a candidate.
+                    touching[found % RUN] = slot as u32;
+                    found += usize::from(touch(circle, other));
+                }
+                start = end;
             }
-            touching[..found]
-                .iter()
-                .for_each(|&offset| visit(start + offset as usize));
-            start = end;
         }
+        touching[..found]
+            .iter()
+            .for_each(|&slot| visit(slot as usize));
     }
 }
 
@@ -128,17 +157,16 @@ impl UniformGrid {
                 };
                 for slot in start..end {
                     let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-                    for range in [slot + 1..same_row_end, above.clone()] {
-                        let probe = (circle, touch);
-                        runs.for_each_touching(probe, range, &self.sorted_circle, |other| {
-                            visit(
-                                index,
-                                self.sorted_index[other],
-                                circle,
-                                self.sorted_circle[other],
-                            );
-                        });
-                    }
+                    let ranges = [slot + 1..same_row_end, above.clone()];
+                    let probe = (circle, touch);
+                    runs.for_each_touching_in(probe, ranges, &self.sorted_circle, |other| {
+                        visit(
+                            index,
+                            self.sorted_index[other],
+                            circle,
+                            self.sorted_circle[other],
+                        );
+                    });
                 }
             }
             if self.big_grid().is_some() {
@@ -197,7 +225,7 @@ mod tests {
     #[test]
     fn every_touching_slot_is_visited_once_in_order_and_no_other() {
         // 100 circles of radius 1 along a line, every third one far off; slots 5..100 are
-        // tested in runs 5..37, 37..69 and 69..100.
+        // tested in chunks 5..21, 21..37, 37..53 and so on.
         let circles: Vec<Circle> = (0..100)
             .map(|k| {
                 let y = if k % 3 == 0 { 50.0 } else { 0.0 };
@@ -211,7 +239,7 @@ mod tests {
             runs.for_each_touching(probe, slots, &circles, |slot| visited.push(slot));
             visited
         };
-        // Across the first two runs: 35, 37 and 38 lie within 3 px (36 and 39 are far off).
+        // Across two chunks: 35, 37 and 38 lie within 3 px (36 and 39 are far off).
         let probe = Circle::new(DVec2::new(37.0, 2.0), 2.0);
         assert_eq!(visited(probe, 5..100), vec![35, 37, 38]);
         let expected: Vec<usize> = (5..100)
@@ -260,5 +288,43 @@ mod tests {
             }
             assert_eq!(joined, all, "{bands} bands");
         }
+    }
+
+    #[test]
+    fn several_ranges_visit_each_one_s_touching_slots_in_turn_however_many() {
+        // 200 circles of radius 1 along a line, every third one far off.
+        let circles: Vec<Circle> = (0..200)
+            .map(|k| {
+                let y = if k % 3 == 0 { 50.0 } else { 0.0 };
+                Circle::new(DVec2::new(k as f64, y), 1.0)
+            })
+            .collect();
+        let mut runs = TouchingRuns::new();
+        let mut most = 0;
+        // Few found, none, and more than the buffer holds (so it is emptied on the way), in
+        // ranges taken in any order, empty ones too.
+        let cases = [
+            (2.0, [5..40, 60..70]),
+            (5.0, [10..10, 30..31]),
+            (60.0, [0..100, 120..200]),
+            (300.0, [150..200, 0..120]),
+            (300.0, [7..7, 0..200]),
+        ];
+        for (radius, ranges) in cases {
+            let probe = Circle::new(DVec2::new(64.0, 0.0), radius);
+            let mut visited = Vec::new();
+            let each = ranges.clone();
+            runs.for_each_touching_in((probe, circles_touch), each, &circles, |slot| {
+                visited.push(slot);
+            });
+            let expected: Vec<usize> = ranges
+                .iter()
+                .flat_map(|range| range.clone())
+                .filter(|&slot| circles_touch(probe, circles[slot]))
+                .collect();
+            assert_eq!(visited, expected, "radius {radius}, {ranges:?}");
+            most = most.max(visited.len());
+        }
+        assert!(most > 4 * RUN, "{most} at most");
     }
 }
