@@ -194,7 +194,7 @@ impl UniformGrid {
     fn visit_big_with_small_in_row(
         &self,
         row: usize,
-        (runs, touch): (&mut TouchingRuns, impl Fn(Circle, Circle) -> bool),
+        (runs, touch): (&mut TouchingRuns, impl Fn(Circle, Circle) -> bool + Copy),
         visit: &mut impl FnMut(u32, u32, Circle, Circle),
     ) {
         for &k in self.big_rows.in_row(row) {
@@ -203,7 +203,7 @@ impl UniformGrid {
             let ((first, _), (last, _)) = self.cells.corners_reached(circle, self.small_reach);
             let start = row * self.cells.columns;
             let slots = self.slots_of(start + first..start + last + 1);
-            runs.for_each_touching((circle, &touch), slots, &self.sorted_circle, |other| {
+            runs.for_each_touching((circle, touch), slots, &self.sorted_circle, |other| {
                 visit(
                     index,
                     self.sorted_index[other],
@@ -222,16 +222,20 @@ mod tests {
     use super::*;
     use crate::sim::geometry::grid::{for_each_pair, mixed_sizes};
 
-    #[test]
-    fn every_touching_slot_is_visited_once_in_order_and_no_other() {
-        // 100 circles of radius 1 along a line, every third one far off; slots 5..100 are
-        // tested in chunks 5..21, 21..37, 37..53 and so on.
-        let circles: Vec<Circle> = (0..100)
+    /// `count` circles of radius 1 along a line, one a pixel, every third one 50 px off it.
+    fn along_a_line(count: usize) -> Vec<Circle> {
+        (0..count)
             .map(|k| {
                 let y = if k % 3 == 0 { 50.0 } else { 0.0 };
                 Circle::new(DVec2::new(k as f64, y), 1.0)
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn every_touching_slot_is_visited_once_in_order_and_no_other() {
+        // Slots 5..100 are tested in chunks 5..21, 21..37, 37..53 and so on.
+        let circles = along_a_line(100);
         let visited = |probe: Circle, slots: Range<usize>| {
             let mut visited = Vec::new();
             let mut runs = TouchingRuns::new();
@@ -292,13 +296,7 @@ mod tests {
 
     #[test]
     fn several_ranges_visit_each_one_s_touching_slots_in_turn_however_many() {
-        // 200 circles of radius 1 along a line, every third one far off.
-        let circles: Vec<Circle> = (0..200)
-            .map(|k| {
-                let y = if k % 3 == 0 { 50.0 } else { 0.0 };
-                Circle::new(DVec2::new(k as f64, y), 1.0)
-            })
-            .collect();
+        let circles = along_a_line(200);
         let mut runs = TouchingRuns::new();
         let mut most = 0;
         // Few found, none, and more than the buffer holds (so it is emptied on the way), in
