@@ -1,8 +1,9 @@
 //! Stage 2, continuous: predicting impacts. At the start of the step every ball goes on the
 //! timeline as a `Mover` (held balls still), and the circles swept along each one's path go
-//! into the grid; their AABBs and distances cut the candidate pairs, and the exact time of
-//! impact gives each approaching pair's moment of contact within the step, and each ball's
-//! first wall contact. During the timeline, a ball redirected by an impact is predicted for
+//! into the grid; their distances cut the candidate pairs, and the exact time of impact gives
+//! each approaching pair's moment of contact within the step, and each ball's first wall
+//! contact. On one thread the movers are made a row of cells ahead of the pair search, so the
+//! search finds them in the cache; on more, all of them first, in parallel. During the timeline, a ball redirected by an impact is predicted for
 //! again against the balls near the rest of its path (`repredict.rs`), with the same
 //! pieces: `pair_time`, the swept circle, the wall's time.
 //!
@@ -10,15 +11,18 @@
 //! straight line: [`approach_time`]. Otherwise (a falling ball and a still one, or one
 //! sliding along a wall) the relative path is a parabola: [`time_to_touch`].
 
+use std::ops::Range;
+
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Party, Prediction, approach_time, swept_circle, swept_circle_under};
 use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, overlapping, within_reach};
 use crate::sim::geometry::flight::time_to_touch;
+use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::search_in_bands;
 use crate::sim::geometry::wall::wall_time_of_impact;
-use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, worth_splitting};
+use crate::sim::parallel::{BALLS_PER_PIECE, in_pieces, piece_ranges, worth_splitting};
 
 /// Pixels added to a redirected ball's swept circle, so rounding can never make the swept
 /// circles' test reject a pair that touches at the very edge of the step.
@@ -48,45 +52,63 @@ impl Timeline {
         });
         // From here on every ball is known by its slot in the grid's cell order.
         self.grid.renumber_by_slot(&mut self.order);
-        // Each ball on the timeline, and its first wall impact, in pieces of slots on the
-        // compute pool for many balls (every mover is written: resizing only sizes them).
         self.movers.resize(self.order.len(), Mover::default());
-        let (grid, order) = (&self.grid, &self.order);
+        self.predictions.clear();
+        let inputs = (circles, velocities, held);
+        let flying = held.iter().filter(|&&held| !held).count();
+        if flying * FEW_FLYING < held.len() {
+            self.place_every_mover(inputs, spec);
+            self.predict_around_the_flying(dt);
+        } else if worth_splitting(self.order.len()) {
+            self.place_every_mover(inputs, spec);
+            self.predict_every_pair(dt);
+        } else {
+            self.predict_row_after_row(inputs, spec);
+        }
+    }
+
+    /// Each ball on the timeline, and its first wall impact, in pieces of slots on the compute
+    /// pool for many balls (every mover is written: resizing only sized them).
+    fn place_every_mover(&mut self, inputs: Inputs, spec: StepSpec) {
+        let (grid, order) = (&self.grid, self.order.as_slice());
         let pieces = self
             .movers
             .chunks_mut(BALLS_PER_PIECE)
-            .zip(order.chunks(BALLS_PER_PIECE))
-            .enumerate();
-        let walls = in_pieces(
-            pieces,
-            worth_splitting(order.len()),
-            |(piece, (movers, balls))| {
-                let first = piece * BALLS_PER_PIECE;
-                let mut walls = Vec::new();
-                for (offset, (mover, &ball)) in movers.iter_mut().zip(balls).enumerate() {
-                    let ball = ball as usize;
-                    *mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
-                    let slot = first + offset;
-                    if let Some((time, wall)) = wall_time(mover, grid.circle_in_slot(slot), spec)
-                        && time <= dt
-                    {
-                        let impact = Impact::with_wall(time, Party::new(slot, order, 0), wall);
-                        walls.push(Prediction::Impact(impact));
-                    }
-                }
-                walls
-            },
-        );
+            .zip(piece_ranges(order.len()));
+        let walls = in_pieces(pieces, worth_splitting(order.len()), |(movers, slots)| {
+            let mut walls = Vec::new();
+            place_movers((movers, slots), (grid, order), inputs, spec, &mut walls);
+            walls
+        });
         // The walls first: the pair search then grows the buffer by exactly what it finds.
-        self.predictions.clear();
         self.predictions
             .reserve_exact(walls.iter().map(Vec::len).sum());
         self.predictions.extend(walls.into_iter().flatten());
-        let flying = self.movers.iter().filter(|mover| !mover.still).count();
-        if flying * FEW_FLYING < self.movers.len() {
-            self.predict_around_the_flying(dt);
-        } else {
-            self.predict_every_pair(dt);
+    }
+
+    /// [`place_every_mover`](Self::place_every_mover), then
+    /// [`predict_every_pair`](Self::predict_every_pair), on one thread: each row's movers
+    /// made just before the search reaches the row below it, so that the search reads them
+    /// from the cache rather than from memory. The impacts found are the same, in another
+    /// order (walls and pairs mixed), which the queue's sort undoes.
+    fn predict_row_after_row(&mut self, inputs: Inputs, spec: StepSpec) {
+        let (grid, order) = (&self.grid, self.order.as_slice());
+        let (movers, found) = (&mut self.movers, &mut self.predictions);
+        let place = |slots: Range<usize>, movers: &mut [Mover], found: &mut Vec<Prediction>| {
+            let movers = &mut movers[slots.clone()];
+            place_movers((movers, slots), (grid, order), inputs, spec, found);
+        };
+        // The big balls' pairs are searched with the first row.
+        place(grid.small_count()..order.len(), movers, found);
+        place(grid.slots_of_row(0), movers, found);
+        for row in 0..grid.rows() {
+            if row + 1 < grid.rows() {
+                place(grid.slots_of_row(row + 1), movers, found);
+            }
+            grid.for_each_pair_within_reach_in_rows(row..row + 1, |i, j, _, _| {
+                let (a, b) = (i.min(j), i.max(j));
+                predict_pair((movers, order), (a, b), spec.dt, found);
+            });
         }
     }
 
@@ -135,6 +157,31 @@ impl Timeline {
                     let pair = (slot.min(other) as u32, slot.max(other) as u32);
                     predict_pair((movers, order), pair, dt, found);
                 });
+        }
+    }
+}
+
+/// What the collision stage is given: the balls' circles at the start of the step, their
+/// velocities, and which hold still.
+type Inputs<'a> = (&'a [Circle], &'a [DVec2], &'a [bool]);
+
+/// Puts the balls in `slots` on the timeline (`movers`, one for each slot), each with its
+/// first wall impact, if any, pushed to `walls`. `order` gives each slot's ball.
+fn place_movers(
+    (movers, slots): (&mut [Mover], Range<usize>),
+    (grid, order): (&UniformGrid, &[u32]),
+    (circles, velocities, held): Inputs,
+    spec: StepSpec,
+    walls: &mut Vec<Prediction>,
+) {
+    for (mover, slot) in movers.iter_mut().zip(slots) {
+        let ball = order[slot] as usize;
+        *mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+        if let Some((time, wall)) = wall_time(mover, grid.circle_in_slot(slot), spec)
+            && time <= spec.dt
+        {
+            let impact = Impact::with_wall(time, Party::new(slot, order, 0), wall);
+            walls.push(Prediction::Impact(impact));
         }
     }
 }
@@ -328,6 +375,64 @@ mod tests {
         let every = sorted(&timeline.predictions);
         assert!(around.len() > 20, "{} predictions", around.len());
         assert_eq!(around, every);
+    }
+
+    #[test]
+    fn the_search_row_after_row_finds_what_the_movers_first_then_the_search_find() {
+        // Balls of radius 3-9, one in a hundred of 60 (big: kept apart in the grid), some
+        // overlapping, every tenth still, one in five ten times as fast; under gravity.
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let circles: Vec<Circle> = (0..1_000_usize)
+            .map(|k| {
+                let center = DVec2::new(
+                    rng.random_range(-390.0..390.0),
+                    rng.random_range(-390.0..390.0),
+                );
+                let radius = if k % 100 == 1 {
+                    60.0
+                } else {
+                    rng.random_range(3.0..9.0)
+                };
+                Circle::new(center, radius)
+            })
+            .collect();
+        let velocities: Vec<DVec2> = (0..1_000_usize)
+            .map(|k| {
+                let fast = if k.is_multiple_of(5) { 10.0 } else { 1.0 };
+                DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..600.0) * fast
+            })
+            .collect();
+        let held: Vec<bool> = (0..1_000).map(|k| k % 10 == 3).collect();
+        let spec = StepSpec::sixtieth(DVec2::splat(400.0), DVec2::new(0.0, -500.0));
+        let mut timeline = Timeline::default();
+        timeline.predict(&circles, &velocities, &held, spec);
+        let row_after_row = sorted(&timeline.predictions);
+        let movers = format!("{:?}", timeline.movers);
+        timeline.movers.fill(Mover::default());
+        timeline.predictions.clear();
+        timeline.place_every_mover((&circles, &velocities, &held), spec);
+        timeline.predict_every_pair(spec.dt);
+        assert_eq!(format!("{:?}", timeline.movers), movers);
+        assert_eq!(row_after_row, sorted(&timeline.predictions));
+        // Walls, overlaps and big balls' pairs among them.
+        let big = timeline.grid.small_count() as u32;
+        let (mut walls, mut overlaps, mut with_big) = (0, 0, 0);
+        for prediction in &timeline.predictions {
+            match *prediction {
+                Prediction::Impact(impact) if impact.wall().is_some() => walls += 1,
+                Prediction::Impact(Impact { a, other, .. }) => {
+                    with_big += usize::from(a.max(other) >= big)
+                }
+                Prediction::Overlap(a, b) => {
+                    overlaps += 1;
+                    with_big += usize::from(a.max(b) >= big);
+                }
+            }
+        }
+        assert!(
+            walls > 10 && overlaps > 10 && with_big > 5,
+            "{walls} walls, {overlaps} overlaps, {with_big} with a big ball"
+        );
     }
 
     #[test]

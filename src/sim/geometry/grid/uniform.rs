@@ -250,6 +250,12 @@ impl UniformGrid {
         self.big_limit
     }
 
+    /// The slots of the balls in the cells of `row`.
+    pub fn slots_of_row(&self, row: usize) -> std::ops::Range<usize> {
+        let columns = self.cells.columns;
+        self.slots_of(row * columns..(row + 1) * columns)
+    }
+
     /// The slots of the balls in the consecutive cells `cells` (the cells hold the slots
     /// `0..small_count()`).
     pub fn slots_of(&self, cells: std::ops::Range<usize>) -> std::ops::Range<usize> {
