@@ -25,12 +25,13 @@ impl Timeline {
     /// Loads what the impacts about to be taken will read, so that it is in the cache when
     /// they are: impacts come in time order, so each one's balls lie anywhere in memory, and
     /// at a million balls waiting for those reads is most of an impact's cost
-    /// (docs/performance.md, *Prefetching the coming impacts*). For the step's first
-    /// predictions a few places ahead, in three stages, each reading only what the one before
-    /// loaded: the balls and their cells; nearer, where the rows of cells around the first
-    /// ball start; nearer still, those rows' first circles. For the earliest impact predicted
-    /// since, all at once. Nothing here changes a result.
-    pub(super) fn prefetch_coming(&self) {
+    /// (docs/performance.md, *Prefetching the coming impacts*). In three stages, each reading
+    /// only what the one before loaded: the balls and their cells; then where the rows of
+    /// cells around the first ball start; then those rows' first circles. For the step's
+    /// first predictions, a few places ahead, a stage each; for the earliest impact predicted
+    /// since, a stage at each call while it stays the earliest, so that no stage waits for
+    /// what the one before is still loading. Nothing here changes a result.
+    pub(super) fn prefetch_coming(&mut self) {
         if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
             self.prefetch_balls(further);
         }
@@ -40,10 +41,27 @@ impl Timeline {
         if let Some(nearer) = self.queue.ahead(PREFETCH_DISTANCE) {
             self.grid.prefetch_cells_around(nearer.a as usize);
         }
-        if let Some(&later) = self.queue.earliest_later() {
-            self.prefetch_balls(later);
-            self.grid.prefetch_cells_around(later.a as usize);
+        self.prefetch_earliest_later();
+    }
+
+    /// The next stage of the loads for the earliest impact predicted during the step: its
+    /// balls when it is new, then where the rows around its first ball start, then their
+    /// first circles, then nothing more.
+    fn prefetch_earliest_later(&mut self) {
+        let Some(&later) = self.queue.earliest_later() else {
+            return;
+        };
+        let stage = match self.later_loaded {
+            Some((seen, stage)) if seen == later => stage,
+            _ => 0,
+        };
+        match stage {
+            0 => self.prefetch_balls(later),
+            1 => self.grid.prefetch_cell_starts_around(later.a as usize),
+            2 => self.grid.prefetch_cells_around(later.a as usize),
+            _ => {}
         }
+        self.later_loaded = Some((later, stage.saturating_add(1)));
     }
 
     /// Loads the movers of `impact`'s balls and their slots in the grid (the second's circle
@@ -65,4 +83,39 @@ pub(super) fn prefetch_mover(movers: &[Mover], slot: u32) {
     let mover = movers.get(slot as usize);
     prefetch(mover.map(|mover| &mover.center));
     prefetch(mover.map(|mover| &mover.hits));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::continuous::impact::Party;
+
+    #[test]
+    fn the_earliest_later_impact_is_loaded_a_stage_a_call_and_a_new_one_from_the_start() {
+        let order = [0, 1, 2, 3];
+        let impact =
+            |time, a, b| Impact::between(time, Party::new(a, &order, 0), Party::new(b, &order, 0));
+        let mut timeline = Timeline::default();
+        timeline.queue.start(std::iter::empty(), 1.0 / 60.0);
+        let stage = |timeline: &Timeline| timeline.later_loaded.map(|(_, stage)| stage);
+        timeline.prefetch_coming();
+        assert_eq!(stage(&timeline), None, "nothing predicted since the start");
+        let (first, earlier) = (impact(0.010, 0, 1), impact(0.005, 2, 3));
+        timeline.queue.push(first);
+        let stages: Vec<_> = (0..5)
+            .map(|_| {
+                timeline.prefetch_coming();
+                stage(&timeline)
+            })
+            .collect();
+        assert_eq!(stages, [Some(1), Some(2), Some(3), Some(4), Some(5)]);
+        assert_eq!(timeline.later_loaded.map(|(seen, _)| seen), Some(first));
+        // An earlier one predicted: it starts from its balls; taken, the first starts again.
+        timeline.queue.push(earlier);
+        timeline.prefetch_coming();
+        assert_eq!(timeline.later_loaded, Some((earlier, 1)));
+        assert_eq!(timeline.queue.pop(), Some(earlier));
+        timeline.prefetch_coming();
+        assert_eq!(timeline.later_loaded, Some((first, 1)));
+    }
 }

@@ -7,7 +7,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::impact::Prediction;
+use super::impact::{Impact, Prediction};
 use super::paths::Paths;
 use super::queue::ImpactQueue;
 use crate::sim::geometry::Circle;
@@ -211,6 +211,9 @@ pub struct Timeline {
     /// The balls the search after an impact found, `(which of its two balls, slot)`, before
     /// each is timed (`Timeline::predict_for_both`).
     pub(super) found: Vec<(u8, u32)>,
+    /// The earliest of the impacts predicted during the step, as the loads ahead last saw it,
+    /// and how many of their stages they have taken for it (`prefetch.rs`).
+    pub(super) later_loaded: Option<(Impact, u8)>,
     /// Whether the last run handled some impact after one that comes later in the impacts'
     /// order (see `Impact`'s `Ord`): then its hits are not in that order.
     pub(super) out_of_order: bool,
