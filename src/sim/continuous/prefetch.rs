@@ -28,10 +28,21 @@ impl Timeline {
     /// (docs/performance.md, *Prefetching the coming impacts*). In three stages, each reading
     /// only what the one before loaded: the balls and their cells; then where the rows of
     /// cells around the first ball start; then those rows' first circles. For the step's
-    /// first predictions, a few places ahead, a stage each; for the earliest impact predicted
-    /// since, a stage at each call while it stays the earliest, so that no stage waits for
-    /// what the one before is still loading. Nothing here changes a result.
+    /// first predictions, a few places ahead, a stage each, once for each of them taken (an
+    /// impact predicted since, taken, leaves them where they were); for the earliest impact
+    /// predicted since, a stage at each call while it stays the earliest, so that no stage
+    /// waits for what the one before is still loading. Nothing here changes a result.
     pub(super) fn prefetch_coming(&mut self) {
+        let taken = self.queue.first_taken();
+        if self.first_loaded != Some(taken) {
+            self.first_loaded = Some(taken);
+            self.prefetch_first_ahead();
+        }
+        self.prefetch_earliest_later();
+    }
+
+    /// The three stages of the loads for the step's first predictions a few places ahead.
+    fn prefetch_first_ahead(&self) {
         if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
             self.prefetch_balls(further);
         }
@@ -41,7 +52,6 @@ impl Timeline {
         if let Some(nearer) = self.queue.ahead(PREFETCH_DISTANCE) {
             self.grid.prefetch_cells_around(nearer.a as usize);
         }
-        self.prefetch_earliest_later();
     }
 
     /// The next stage of the loads for the earliest impact predicted during the step: its
@@ -91,17 +101,19 @@ mod tests {
     use crate::sim::continuous::impact::Party;
 
     #[test]
-    fn the_earliest_later_impact_is_loaded_a_stage_a_call_and_a_new_one_from_the_start() {
-        let order = [0, 1, 2, 3];
+    fn the_loads_ahead_follow_what_is_taken_and_the_earliest_later_one_by_stages() {
+        let order = [0, 1, 2, 3, 4, 5];
         let impact =
             |time, a, b| Impact::between(time, Party::new(a, &order, 0), Party::new(b, &order, 0));
         let mut timeline = Timeline::default();
-        timeline.queue.start(std::iter::empty(), 1.0 / 60.0);
+        let first = [impact(0.002, 0, 1), impact(0.014, 4, 5)];
+        timeline.queue.start(first.into_iter(), 1.0 / 60.0);
         let stage = |timeline: &Timeline| timeline.later_loaded.map(|(_, stage)| stage);
         timeline.prefetch_coming();
+        assert_eq!(timeline.first_loaded, Some(0));
         assert_eq!(stage(&timeline), None, "nothing predicted since the start");
-        let (first, earlier) = (impact(0.010, 0, 1), impact(0.005, 2, 3));
-        timeline.queue.push(first);
+        let (later, earlier) = (impact(0.010, 0, 1), impact(0.005, 2, 3));
+        timeline.queue.push(later);
         let stages: Vec<_> = (0..5)
             .map(|_| {
                 timeline.prefetch_coming();
@@ -109,13 +121,20 @@ mod tests {
             })
             .collect();
         assert_eq!(stages, [Some(1), Some(2), Some(3), Some(4), Some(5)]);
-        assert_eq!(timeline.later_loaded.map(|(seen, _)| seen), Some(first));
-        // An earlier one predicted: it starts from its balls; taken, the first starts again.
+        assert_eq!(timeline.later_loaded.map(|(seen, _)| seen), Some(later));
+        // An earlier one predicted: it starts from its balls.
         timeline.queue.push(earlier);
         timeline.prefetch_coming();
         assert_eq!(timeline.later_loaded, Some((earlier, 1)));
+        // The first prediction taken: the ones ahead of it are loaded anew.
+        assert_eq!(timeline.queue.pop(), Some(first[0]));
+        timeline.prefetch_coming();
+        assert_eq!(timeline.first_loaded, Some(1));
+        // One predicted since taken: the first ones stay as loaded, and the next earliest
+        // later one starts again from its balls.
         assert_eq!(timeline.queue.pop(), Some(earlier));
         timeline.prefetch_coming();
-        assert_eq!(timeline.later_loaded, Some((first, 1)));
+        assert_eq!(timeline.first_loaded, Some(1));
+        assert_eq!(timeline.later_loaded, Some((later, 1)));
     }
 }

@@ -40,6 +40,12 @@ impl ImpactQueue {
         self.later.push(impact);
     }
 
+    /// How many of the step's first predictions have been taken: [`ahead`](Self::ahead)
+    /// gives the same ones until this changes.
+    pub fn first_taken(&self) -> usize {
+        self.next
+    }
+
     /// The step's first prediction `distance` places after the next one left: most likely
     /// taken soon (an impact predicted since may come first, or make it stale).
     pub fn ahead(&self, distance: usize) -> Option<&Impact> {

@@ -211,6 +211,9 @@ pub struct Timeline {
     /// The balls the search after an impact found, `(which of its two balls, slot)`, before
     /// each is timed (`Timeline::predict_for_both`).
     pub(super) found: Vec<(u8, u32)>,
+    /// How many of the step's first predictions had been taken when the loads ahead last
+    /// loaded the ones ahead of them (`prefetch.rs`): until that changes, they are loaded.
+    pub(super) first_loaded: Option<usize>,
     /// The earliest of the impacts predicted during the step, as the loads ahead last saw it,
     /// and how many of their stages they have taken for it (`prefetch.rs`).
     pub(super) later_loaded: Option<(Impact, u8)>,

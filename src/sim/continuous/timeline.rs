@@ -107,7 +107,7 @@ impl Timeline {
     /// yet; the predictions queued. `dt` is the step's length.
     pub(super) fn start(&mut self, dt: f64) {
         self.paths.reset(&self.grid);
-        self.later_loaded = None;
+        (self.first_loaded, self.later_loaded) = (None, None);
         self.queue.start(
             self.predictions
                 .iter()
