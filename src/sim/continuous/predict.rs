@@ -3,9 +3,10 @@
 //! into the grid; their distances cut the candidate pairs, and the exact time of impact gives
 //! each approaching pair's moment of contact within the step, and each ball's first wall
 //! contact. On one thread the movers are made a row of cells ahead of the pair search, so the
-//! search finds them in the cache; on more, all of them first, in parallel. During the timeline, a ball redirected by an impact is predicted for
-//! again against the balls near the rest of its path (`repredict.rs`), with the same
-//! pieces: `pair_time`, the swept circle, the wall's time.
+//! search finds them in the cache; on more, all of them first, in parallel. During the
+//! timeline, a ball redirected by an impact is predicted for again against the balls near the
+//! rest of its path (`repredict.rs`), with the same pieces: `pair_time`, the swept circle, the
+//! wall's time.
 //!
 //! Two balls with the same acceleration (both in free flight, or both still) close in a
 //! straight line: [`approach_time`]. Otherwise (a falling ball and a still one, or one
@@ -106,8 +107,7 @@ impl Timeline {
                 place(grid.slots_of_row(row + 1), movers, found);
             }
             grid.for_each_pair_within_reach_in_rows(row..row + 1, |i, j, _, _| {
-                let (a, b) = (i.min(j), i.max(j));
-                predict_pair((movers, order), (a, b), spec.dt, found);
+                predict_pair((movers, order), (i, j), spec.dt, found);
             });
         }
     }
@@ -119,8 +119,7 @@ impl Timeline {
         let (movers, order) = (&self.movers, &self.order);
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
             grid.for_each_pair_within_reach_in_rows(rows, |i, j, _, _| {
-                let (a, b) = (i.min(j), i.max(j));
-                predict_pair((movers, order), (a, b), dt, found);
+                predict_pair((movers, order), (i, j), dt, found);
             });
         });
     }
@@ -154,8 +153,7 @@ impl Timeline {
                     {
                         return;
                     }
-                    let pair = (slot.min(other) as u32, slot.max(other) as u32);
-                    predict_pair((movers, order), pair, dt, found);
+                    predict_pair((movers, order), (slot as u32, other as u32), dt, found);
                 });
         }
     }
@@ -262,14 +260,16 @@ pub(super) fn wall_time(
 /// only.
 const FEW_FLYING: usize = 4;
 
-/// What the search finds for the pair of slots `(a, b)`, `a < b`: an overlap at the start, an
-/// impact within the step. `order` gives each slot's index in the step's input.
+/// What the search finds for the pair of slots `(i, j)`, in either order: an overlap at the
+/// start, an impact within the step, each naming the lower slot first. `order` gives each
+/// slot's index in the step's input.
 fn predict_pair(
     (movers, order): (&[Mover], &[u32]),
-    (a, b): (u32, u32),
+    (i, j): (u32, u32),
     dt: f64,
     found: &mut Vec<Prediction>,
 ) {
+    let (a, b) = (i.min(j), i.max(j));
     let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
     if overlapping(mover_a.circle(), mover_b.circle()) {
         found.push(Prediction::Overlap(a, b));
