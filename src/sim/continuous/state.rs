@@ -102,8 +102,11 @@ impl StepSpec {
 /// sets it flying: its `velocity` is then only what it will have at the end of the step.
 ///
 /// Its fields lie in the order written (`repr(C)`, 72 B): the timeline's prefetching loads
-/// its first and its last lines by `center` and `hits`.
-#[derive(Clone, Copy, Debug, Default)]
+/// its first and its last lines by `center` and `hits`. They are plain numbers
+/// (`bytemuck::Pod`: whether it is still is a byte, not a `bool`), so that the timeline's
+/// buffer of movers can hold the step's swept circles while the grid is built
+/// ([`Timeline::predict`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 pub(super) struct Mover {
     pub center: DVec2,
@@ -113,7 +116,9 @@ pub(super) struct Mover {
     pub radius: f64,
     pub clock: f64,
     pub hits: u32,
-    pub still: bool,
+    /// 1 while it holds still, else 0 ([`is_still`](Self::is_still)).
+    still: u8,
+    _padding: [u8; 3],
 }
 
 impl Mover {
@@ -125,8 +130,21 @@ impl Mover {
             radius: circle.radius,
             clock: 0.0,
             hits: 0,
-            still,
+            still: u8::from(still),
+            _padding: [0; 3],
         }
+    }
+
+    /// Whether it holds still (see the type's header).
+    #[inline]
+    pub fn is_still(&self) -> bool {
+        self.still != 0
+    }
+
+    /// Holds still from now on, with its acceleration gone.
+    pub fn hold_still(&mut self) {
+        self.still = 1;
+        self.accel = DVec2::ZERO;
     }
 
     pub fn circle(&self) -> Circle {
@@ -136,7 +154,7 @@ impl Mover {
     /// The velocity it moves at now: zero while still.
     #[inline]
     pub fn moving_velocity(&self) -> DVec2 {
-        if self.still {
+        if self.is_still() {
             DVec2::ZERO
         } else {
             self.velocity
@@ -164,7 +182,7 @@ impl Mover {
     /// velocity is the one it will have at the end of the step).
     #[inline]
     pub fn state_at(&self, time: f64) -> (DVec2, DVec2) {
-        if self.still {
+        if self.is_still() {
             (self.center, self.velocity)
         } else {
             (self.center_at(time), self.velocity_at(time))
@@ -181,7 +199,7 @@ impl Mover {
     pub fn fly(&mut self, velocity: DVec2, gravity: DVec2) {
         self.velocity = velocity;
         self.accel = gravity;
-        self.still = false;
+        self.still = 0;
     }
 }
 
@@ -258,7 +276,52 @@ impl Timeline {
 
 #[cfg(test)]
 mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
     use super::*;
+    use crate::sim::continuous::impact::swept_circle_under;
+
+    #[test]
+    fn the_grid_holds_each_swept_circle_and_every_mover_is_made_again_after_the_loan() {
+        // The movers' buffer holds the swept circles while the grid is built: afterwards the
+        // grid must hold each ball's swept circle and every slot its own mover, as the count
+        // grows, shrinks and grows again (every seventh ball held still, under gravity).
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let spec = StepSpec::sixtieth(DVec2::splat(400.0), DVec2::new(30.0, -600.0));
+        let mut timeline = Timeline::default();
+        for count in [1_500, 3_000, 500, 2_000] {
+            let circles: Vec<Circle> = (0..count)
+                .map(|_| {
+                    let center = DVec2::new(
+                        rng.random_range(-390.0..390.0),
+                        rng.random_range(-390.0..390.0),
+                    );
+                    Circle::new(center, rng.random_range(2.0..6.0))
+                })
+                .collect();
+            let velocities: Vec<DVec2> = (0..count)
+                .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * 400.0)
+                .collect();
+            let held: Vec<bool> = (0..count).map(|ball| ball % 7 == 3).collect();
+            timeline.predict(&circles, &velocities, &held, spec);
+            assert_eq!(timeline.movers.len(), count);
+            for slot in 0..count {
+                let ball = timeline.order[slot] as usize;
+                let mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+                let accel_length = if held[ball] {
+                    0.0
+                } else {
+                    spec.gravity.length()
+                };
+                let accel = (mover.accel, accel_length);
+                let swept =
+                    swept_circle_under(circles[ball], mover.moving_velocity(), accel, spec.dt);
+                assert_eq!(timeline.grid.circle_in_slot(slot), swept, "slot {slot}");
+                assert_eq!(timeline.movers[slot], mover, "slot {slot}");
+            }
+        }
+    }
 
     #[test]
     fn the_hit_limit_covers_twice_a_light_ball_s_chain_of_hits_between_a_heavy_one_and_a_wall() {

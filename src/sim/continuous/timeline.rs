@@ -208,8 +208,8 @@ impl Timeline {
             self.come_to_rest(a, b, normal, now, spec);
             return;
         }
-        if spec.rest_speed > 0.0 && ma.still != mb.still {
-            self.stop_for_the_solver(if ma.still { b } else { a }, now, spec);
+        if spec.rest_speed > 0.0 && ma.is_still() != mb.is_still() {
+            self.stop_for_the_solver(if ma.is_still() { b } else { a }, now, spec);
             return;
         }
         let Some(exchange) = normal_exchange(
@@ -243,7 +243,7 @@ impl Timeline {
     /// lose their closing speed (restitution 0) and fly on.
     fn come_to_rest(&mut self, a: usize, b: usize, normal: DVec2, now: f64, spec: StepSpec) {
         let (ma, mb) = (self.movers[a], self.movers[b]);
-        match (ma.still, mb.still) {
+        match (ma.is_still(), mb.is_still()) {
             (true, true) => {}
             (false, true) => self.stop_on_support(a, normal, now, spec),
             (true, false) => self.stop_on_support(b, -normal, now, spec),
@@ -275,8 +275,7 @@ impl Timeline {
     /// the solver at the next step, whose restitution pass bounces it off the pile.
     fn stop_for_the_solver(&mut self, slot: usize, now: f64, spec: StepSpec) {
         let mover = &mut self.movers[slot];
-        mover.still = true;
-        mover.accel = DVec2::ZERO;
+        mover.hold_still();
         mover.hits += 1;
         self.predict_for(slot, now, spec);
     }
@@ -286,8 +285,7 @@ impl Timeline {
     fn stop_on_support(&mut self, slot: usize, into: DVec2, now: f64, spec: StepSpec) {
         let mover = &mut self.movers[slot];
         mover.velocity -= into * mover.velocity.dot(into).max(0.0);
-        mover.still = true;
-        mover.accel = DVec2::ZERO;
+        mover.hold_still();
         mover.hits += 1;
         self.predict_for(slot, now, spec);
     }
@@ -318,8 +316,8 @@ impl Timeline {
                 mover.state_at(spec.dt)
             };
             (circles[index].center, velocities[index]) = (center, velocity);
-            held[index] &= mover.still && mover.hits == 0;
-            stopped[index] = mover.still && !held[index];
+            held[index] &= mover.is_still() && mover.hits == 0;
+            stopped[index] = mover.is_still() && !held[index];
             inside &= lies_inside(center, mover.radius, spec.half);
         }
         self.ends_inside = inside;

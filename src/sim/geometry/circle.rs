@@ -7,8 +7,10 @@
 
 use bevy::math::DVec2;
 
-/// A circle in arena coordinates (pixels).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A circle in arena coordinates (pixels). Plain numbers (`bytemuck::Pod`), so a buffer of
+/// other plain numbers may hold circles for a while.
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Circle {
     pub center: DVec2,
     /// Pixels; always positive for a valid ball.
