@@ -47,8 +47,7 @@ impl Timeline {
         self.movers.resize(circles.len(), Mover::default());
         let swept = &mut bytemuck::cast_slice_mut(&mut self.movers)[..circles.len()];
         make_swept_circles(swept, (circles, velocities, held), spec);
-        let swept = &*swept;
-        self.grid.rebuild_with(circles.len(), |ball| swept[ball]);
+        self.grid.rebuild(swept);
         // From here on every ball is known by its slot in the grid's cell order.
         self.grid.renumber_by_slot(&mut self.order);
         self.predictions.clear();

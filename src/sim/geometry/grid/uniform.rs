@@ -63,9 +63,9 @@ impl UniformGrid {
         self.rebuild_with(circles.len(), |index| circles[index]);
     }
 
-    /// [`rebuild`](Self::rebuild) with the `count` circles made by `circle_at(index)` (each
-    /// made a few times), for a caller that would otherwise keep a copy of them only to sort.
-    pub fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle + Sync) {
+    /// [`rebuild`](Self::rebuild) with the `count` circles given by `circle_at(index)`, each
+    /// asked for a few times (its extent, its cell, its place in slot order).
+    fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle + Sync) {
         // The extent, the radii's sum and the largest radius in one pass, in pieces (on the
         // compute pool for many balls): the pieces' sums are added in their order, and a
         // piece's size is fixed, so the mean's rounding never depends on the threads.
