@@ -165,7 +165,8 @@ impl TimeBuckets {
     /// `count` buckets (at least one) over `horizon` seconds; a horizon that is not a positive
     /// number puts everything into one bucket.
     fn over(horizon: f64, count: usize) -> Self {
-        let count = count.max(1);
+        // At most `u32::MAX`, which `of` counts on.
+        let count = count.clamp(1, u32::MAX as usize);
         let scale = if horizon > 0.0 && horizon.is_finite() {
             count as f64 / horizon
         } else {
@@ -180,8 +181,10 @@ impl TimeBuckets {
         if time.is_nan() && time.is_sign_positive() {
             return last; // after every other time
         }
-        // `as` rounds down and saturates: a negative time (or NaN) to 0, a huge one to the max.
-        ((time * self.scale) as usize).min(last)
+        // `as` rounds down and saturates: a negative time (or NaN) to 0, a huge one to the max;
+        // through `u32`, whose conversion takes fewer instructions than `usize`'s, for the same
+        // bucket (there are at most `u32::MAX`).
+        ((time * self.scale) as u32 as usize).min(last)
     }
 }
 
