@@ -280,7 +280,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::sim::continuous::impact::swept_circle_under;
+    use crate::sim::continuous::predict::swept_by;
 
     #[test]
     fn the_grid_holds_each_swept_circle_and_every_mover_is_made_again_after_the_loan() {
@@ -309,14 +309,7 @@ mod tests {
             for slot in 0..count {
                 let ball = timeline.order[slot] as usize;
                 let mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
-                let accel_length = if held[ball] {
-                    0.0
-                } else {
-                    spec.gravity.length()
-                };
-                let accel = (mover.accel, accel_length);
-                let swept =
-                    swept_circle_under(circles[ball], mover.moving_velocity(), accel, spec.dt);
+                let swept = swept_by(&mover, spec.dt);
                 assert_eq!(timeline.grid.circle_in_slot(slot), swept, "slot {slot}");
                 assert_eq!(timeline.movers[slot], mover, "slot {slot}");
             }
