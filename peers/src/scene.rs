@@ -2,7 +2,7 @@
 //! arena's corner at the origin, and the physics the scene sets. Loaded and drawn by
 //! ballpit's own code, so every engine starts from the state `ballpit run` starts from.
 
-use ballpit::sim::{MassModel, SceneFile};
+use ballpit::sim::{MassModel, SceneFile, SceneSetup};
 use bevy::math::DVec2;
 
 /// Pixels per metre when handing the scene to an engine: radii 5–15 px become 0.05–0.15 m,
@@ -29,6 +29,8 @@ pub struct Scene {
     pub mass_model: MassModel,
     /// Seconds.
     pub dt: f64,
+    /// The scene as ballpit loads it, for `--interleave`'s ballpit engine.
+    pub setup: SceneSetup,
 }
 
 impl Scene {
@@ -60,6 +62,7 @@ impl Scene {
             restitution: setup.params.restitution,
             mass_model: setup.params.mass_model,
             dt: ballpit::headless::DEFAULT_DT,
+            setup,
         })
     }
 
