@@ -17,6 +17,7 @@ use std::ops::Range;
 use bevy::math::DVec2;
 
 use super::impact::{Impact, Party, Prediction, approach_time, swept_circle, swept_circle_under};
+use super::prefetch::{INPUTS_AHEAD, prefetch_inputs};
 use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, overlapping, within_reach};
 use crate::sim::geometry::flight::time_to_touch;
@@ -157,7 +158,7 @@ impl Timeline {
 
 /// What the collision stage is given: the balls' circles at the start of the step, their
 /// velocities, and which hold still.
-type Inputs<'a> = (&'a [Circle], &'a [DVec2], &'a [bool]);
+pub(super) type Inputs<'a> = (&'a [Circle], &'a [DVec2], &'a [bool]);
 
 /// Each ball's circle swept over the step, by its index in `inputs`, in pieces on the compute
 /// pool for many balls. A new mover accelerates at gravity, or not at all if still; gravity's
@@ -190,6 +191,7 @@ fn place_movers(
     walls: &mut Vec<Prediction>,
 ) {
     for (mover, slot) in movers.iter_mut().zip(slots) {
+        prefetch_inputs((circles, velocities, held), order, slot + INPUTS_AHEAD);
         let ball = order[slot] as usize;
         *mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
         if let Some((time, wall)) = wall_time(mover, grid.circle_in_slot(slot), spec)

@@ -3,9 +3,11 @@
 //! anywhere in memory, and at a million balls waiting for those reads is most of an impact's
 //! cost (docs/performance.md, *Prefetching the coming impacts* and *The loads ahead in three
 //! stages*). The timeline's loop calls
-//! [`Timeline::prefetch_coming`] before each impact; nothing here changes a result.
+//! [`Timeline::prefetch_coming`] before each impact, and the pass that puts the balls on the
+//! timeline calls [`prefetch_inputs`] a few balls ahead; nothing here changes a result.
 
 use super::impact::Impact;
+use super::predict::Inputs;
 use super::state::{Mover, Timeline};
 use crate::sim::cache::{PREFETCH_MIN_BALLS, prefetch};
 
@@ -86,6 +88,28 @@ impl Timeline {
     }
 }
 
+/// How many slots ahead of the ball it is placing the pass that puts the balls on the
+/// timeline (`predict.rs`, `place_movers`) loads a ball's inputs ([`prefetch_inputs`]).
+pub(super) const INPUTS_AHEAD: usize = 16;
+
+/// Loads what the collision stage was given for the ball in `slot` (its circle, velocity and
+/// whether it is held), for many balls: the movers are made in the grid's slot order, which
+/// reads the inputs by each ball's index, scattered in memory. At 100,000 balls that pass
+/// spent most of its time waiting for those reads (docs/performance.md, *The inputs loaded
+/// ahead of the movers*).
+pub(super) fn prefetch_inputs((circles, velocities, held): Inputs, order: &[u32], slot: usize) {
+    let Some(&ball) = order
+        .get(slot)
+        .filter(|_| order.len() >= PREFETCH_MIN_BALLS)
+    else {
+        return;
+    };
+    let ball = ball as usize;
+    prefetch(circles.get(ball));
+    prefetch(velocities.get(ball));
+    prefetch(held.get(ball));
+}
+
 /// Loads the mover in `slot`, if any.
 pub(super) fn prefetch_mover(movers: &[Mover], slot: u32) {
     // A mover spans two cache lines: its first field and its last but one bring both (its
@@ -99,6 +123,25 @@ pub(super) fn prefetch_mover(movers: &[Mover], slot: u32) {
 mod tests {
     use super::*;
     use crate::sim::continuous::impact::Party;
+
+    #[test]
+    fn loading_the_inputs_ahead_asks_only_for_balls_that_are_there() {
+        // Many balls (loads asked for) and few (none), slots past the end, and an order that
+        // names a ball past the inputs: nothing is read out of bounds.
+        use crate::sim::geometry::circle::Circle;
+        use bevy::math::DVec2;
+        for count in [10, PREFETCH_MIN_BALLS + 10] {
+            let circles = vec![Circle::new(DVec2::ZERO, 1.0); count];
+            let velocities = vec![DVec2::ZERO; count];
+            let held = vec![false; count];
+            let mut order: Vec<u32> = (0..count as u32).rev().collect();
+            order[0] = count as u32 + 5;
+            let inputs = (&circles[..], &velocities[..], &held[..]);
+            for slot in [0, 1, count - 1, count, count + INPUTS_AHEAD, usize::MAX] {
+                prefetch_inputs(inputs, &order, slot);
+            }
+        }
+    }
 
     #[test]
     fn the_loads_ahead_follow_what_is_taken_and_the_earliest_later_one_by_stages() {
