@@ -158,7 +158,7 @@ impl Timeline {
 
 /// What the collision stage is given: the balls' circles at the start of the step, their
 /// velocities, and which hold still.
-pub(super) type Inputs<'a> = (&'a [Circle], &'a [DVec2], &'a [bool]);
+type Inputs<'a> = (&'a [Circle], &'a [DVec2], &'a [bool]);
 
 /// Each ball's circle swept over the step, by its index in `inputs`, in pieces on the compute
 /// pool for many balls. A new mover accelerates at gravity, or not at all if still; gravity's

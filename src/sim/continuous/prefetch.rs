@@ -6,10 +6,12 @@
 //! [`Timeline::prefetch_coming`] before each impact, and the pass that puts the balls on the
 //! timeline calls [`prefetch_inputs`] a few balls ahead; nothing here changes a result.
 
+use bevy::math::DVec2;
+
 use super::impact::Impact;
-use super::predict::Inputs;
 use super::state::{Mover, Timeline};
 use crate::sim::cache::{PREFETCH_MIN_BALLS, prefetch};
+use crate::sim::geometry::circle::Circle;
 
 /// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
 /// cells around a ball (half as many again ahead, where their rows start; twice as many, the
@@ -97,7 +99,11 @@ pub(super) const INPUTS_AHEAD: usize = 16;
 /// reads the inputs by each ball's index, scattered in memory. At 100,000 balls that pass
 /// spent most of its time waiting for those reads (docs/performance.md, *The inputs loaded
 /// ahead of the movers*).
-pub(super) fn prefetch_inputs((circles, velocities, held): Inputs, order: &[u32], slot: usize) {
+pub(super) fn prefetch_inputs(
+    (circles, velocities, held): (&[Circle], &[DVec2], &[bool]),
+    order: &[u32],
+    slot: usize,
+) {
     let Some(&ball) = order
         .get(slot)
         .filter(|_| order.len() >= PREFETCH_MIN_BALLS)
@@ -128,8 +134,6 @@ mod tests {
     fn loading_the_inputs_ahead_asks_only_for_balls_that_are_there() {
         // Many balls (loads asked for) and few (none), slots past the end, and an order that
         // names a ball past the inputs: nothing is read out of bounds.
-        use crate::sim::geometry::circle::Circle;
-        use bevy::math::DVec2;
         for count in [10, PREFETCH_MIN_BALLS + 10] {
             let circles = vec![Circle::new(DVec2::ZERO, 1.0); count];
             let velocities = vec![DVec2::ZERO; count];
