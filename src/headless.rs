@@ -91,6 +91,17 @@ pub fn median(values: &mut [f64]) -> f64 {
     }
 }
 
+/// The value a tenth of the way up `values` sorted (the lower of the nearest ranks): a run's
+/// quickest tenth of steps took at most this. On a host that slows for spells, it tells the
+/// speed between them. Zero for none.
+pub fn quickest_tenth(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    values[(values.len() - 1) / 10]
+}
+
 pub fn mean(values: &[f64]) -> f64 {
     if values.is_empty() {
         0.0
@@ -108,6 +119,10 @@ mod tests {
         assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
         assert_eq!(median(&mut []), 0.0);
+        let mut steps: Vec<f64> = (1..=200).rev().map(f64::from).collect();
+        assert_eq!(quickest_tenth(&mut steps), 20.0);
+        assert_eq!(quickest_tenth(&mut [7.0, 3.0]), 3.0);
+        assert_eq!(quickest_tenth(&mut []), 0.0);
         assert_eq!(mean(&[1.0, 2.0, 6.0]), 3.0);
     }
 

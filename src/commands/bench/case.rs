@@ -6,7 +6,9 @@ use std::process::Command;
 
 use serde::{Deserialize, Serialize};
 
-use crate::headless::{DEFAULT_DT, counters_only, headless_app_with_threads, median, time_steps};
+use crate::headless::{
+    DEFAULT_DT, counters_only, headless_app_with_threads, median, quickest_tenth, time_steps,
+};
 use crate::sim::{BroadPhase, CollisionMode, SceneFile, SimStats, Solver};
 
 /// The standard gas, built in so the bench runs from any directory.
@@ -42,6 +44,9 @@ pub struct CaseResult {
     /// Threads at work on each step (the main thread and the compute pool's workers).
     pub threads: usize,
     pub ms_per_step_median: f64,
+    /// The quickest tenth of the steps took at most this ([`quickest_tenth`]).
+    #[serde(default)]
+    pub ms_per_step_p10: f64,
     pub ns_per_ball_step: f64,
     pub contacts_per_step: f64,
     /// Ball–ball collisions (momentum exchanges) per step.
@@ -108,6 +113,7 @@ pub fn run_case(case: BenchCase, threads: usize) -> Result<CaseResult, Box<dyn E
         cores: available_cores(),
         threads,
         ms_per_step_median: median,
+        ms_per_step_p10: quickest_tenth(&mut step_ms),
         ns_per_ball_step: median * 1e6 / case.balls.max(1) as f64,
         contacts_per_step: contacts / steps,
         collisions_per_step: collisions / steps,

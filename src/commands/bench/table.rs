@@ -131,6 +131,7 @@ mod tests {
             cores: 1,
             threads: 1,
             ms_per_step_median: ms,
+            ms_per_step_p10: ms,
             ns_per_ball_step: ms * 1e6 / balls as f64,
             contacts_per_step: 0.0,
             collisions_per_step: 0.0,
@@ -174,6 +175,7 @@ mod tests {
             cores: 2,
             threads: 2,
             ms_per_step_median: ms,
+            ms_per_step_p10: 0.9 * ms,
             ns_per_ball_step: ms * 1e3,
             contacts_per_step: ms * 10.0,
             collisions_per_step: 0.0,
@@ -185,9 +187,10 @@ mod tests {
         let median =
             CaseResult::median_round(vec![round(3.0, 40.0), round(1.0, 45.0), round(2.0, 41.0)])
                 .unwrap();
-        // The whole of the middle round (its per-ball cost and counts with it), every
-        // round's median in the order run, the highest peak.
+        // The whole of the middle round (its per-ball cost, counts and quickest tenth with
+        // it), every round's median in the order run, the highest peak.
         assert_eq!(median.ms_per_step_median, 2.0);
+        assert_eq!(median.ms_per_step_p10, 1.8);
         assert_eq!(median.ns_per_ball_step, 2000.0);
         assert_eq!(median.contacts_per_step, 20.0);
         assert_eq!(median.rounds_ms_per_step, [3.0, 1.0, 2.0]);
