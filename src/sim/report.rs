@@ -195,6 +195,12 @@ impl HitLog {
         }
     }
 
+    /// Counts `count` ball hits that this step drops, as [`push`](Self::push) would.
+    pub fn count_dropped(&mut self, count: u64) {
+        debug_assert!(self.drop_ball_hits || count == 0);
+        self.ball_hits_not_kept += count;
+    }
+
     /// Records each of `hits` as [`push`](Self::push) does.
     pub fn extend(&mut self, hits: impl IntoIterator<Item = Hit>) {
         for hit in hits {

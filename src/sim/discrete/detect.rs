@@ -19,9 +19,10 @@ use crate::sim::report::{ContactPoint, StepLog};
 #[derive(Resource, Debug, Default)]
 pub struct Contacts(pub FoundInBands<IndexedContact>);
 
-/// The grid, kept between steps to reuse its buffers.
+/// The grid, kept between steps to reuse its buffers; the response reads the rows it filed
+/// the balls in.
 #[derive(Resource, Default)]
-pub struct DetectionGrid(UniformGrid);
+pub struct DetectionGrid(pub(super) UniformGrid);
 
 pub fn detect_contacts(
     solver: Res<Solver>,

@@ -4,4 +4,5 @@
 //! stage 3). Fast balls can pass through each other; the continuous mode is the cure.
 
 pub mod detect;
+pub mod parts;
 pub mod resolve;

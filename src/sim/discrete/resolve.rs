@@ -4,21 +4,25 @@
 //!
 //! Runs in [`SimSystems::Response`](crate::sim::SimSystems::Response) in discrete mode,
 //! reading [`Contacts`] in their stable order (Gauss–Seidel: each contact sees the velocities
-//! the earlier ones left). Works on the contiguous [`BallSnapshot`] by index, then contains
-//! the balls in a contact in the arena again and writes every ball (the movement stage moved
-//! them in the snapshot) back to its components, both in pieces on the compute pool for many
-//! balls. Records each exchange and wall hit in the [`StepLog`]. The resting rule applies to
-//! pairs and walls alike (see
+//! the earlier ones left); for many balls on more than one thread, in a step that only counts
+//! its ball hits, in [`parts`](super::parts) of the arrays at once with the same result, by
+//! the rows of the [`DetectionGrid`]. Works on the contiguous [`BallSnapshot`] by index,
+//! then contains the balls in a contact in the arena again and writes every ball (the
+//! movement stage moved them in the snapshot) back to its components, both in pieces on the
+//! compute pool for many balls. Records each exchange and wall hit in the [`StepLog`]. The
+//! resting rule applies to pairs and walls alike (see
 //! [`resolve_overlaps`](crate::sim::geometry::impulse::resolve_overlaps)); pairs of resting
 //! balls are the resting stage's.
 
 use bevy::prelude::*;
 
-use super::detect::Contacts;
+use super::detect::{Contacts, DetectionGrid};
+use super::parts::ExchangesInParts;
 use crate::sim::ball::{BallSnapshot, WrittenBalls, write_back_after};
 use crate::sim::clock::SimClock;
 use crate::sim::geometry::impulse::resolve_found_contacts;
 use crate::sim::movement::Arena;
+use crate::sim::parallel::{threads_at_work, worth_splitting};
 use crate::sim::params::SimParams;
 use crate::sim::report::{Hit, StepLog};
 
@@ -29,7 +33,9 @@ pub fn resolve_contacts(
     mut snapshot: ResMut<BallSnapshot>,
     mut balls: WrittenBalls,
     mut log: ResMut<StepLog>,
+    grid: Res<DetectionGrid>,
     mut in_contact: Local<Vec<bool>>,
+    mut in_parts: Local<ExchangesInParts>,
 ) {
     if snapshot.all_held() {
         return; // nothing moved, and nothing touches
@@ -48,14 +54,23 @@ pub fn resolve_contacts(
     // Discrete mode sees a hit only at the end of the step, as an overlap.
     let step_end = clock.dt;
     let log = &mut *log;
-    let hits = &mut log.hits;
-    // Each contact's balls marked as it is taken, while they are in the cache; band after
-    // band, as the search found them.
-    let mut record =
-        |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange));
-    for band in contacts.0.bands() {
+    // Each contact's balls marked as it is taken, while they are in the cache.
+    if worth_splitting(entities.len()) && !log.keeps_ball_hits() {
+        // In parts of the arrays at once, with the same result; the hits only counted.
         let arrays = (&mut circles[..], &mut velocities[..], &mut held[..]);
-        resolve_found_contacts(band, &mut in_contact, arrays, constants, &mut record);
+        let found = (&contacts.0, &grid.0);
+        let parts = threads_at_work();
+        let exchanges = in_parts.resolve(found, parts, &mut in_contact, arrays, constants);
+        log.hits.count_dropped(exchanges);
+    } else {
+        // Band after band, as the search found them, each hit recorded as it happens.
+        let hits = &mut log.hits;
+        let mut record =
+            |a, b, geometry, exchange| hits.push(Hit::ball(a, b, step_end, geometry, exchange));
+        for band in contacts.0.bands() {
+            let arrays = (&mut circles[..], &mut velocities[..], &mut held[..]);
+            resolve_found_contacts(band, &mut in_contact, arrays, constants, &mut record);
+        }
     }
     // Every ball written back (the movement stage moved them in the snapshot only), each piece
     // after the walls again for its balls in a contact: separation may have pushed them into a

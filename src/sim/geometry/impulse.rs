@@ -121,18 +121,41 @@ pub fn resolve_found_contacts(
     constants: (MassModel, f64, f64),
     on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
 ) {
+    let every = (0, |_: &IndexedContact, _| true);
+    let arrays = (circles, velocities, held);
+    resolve_found_contacts_in_part(contacts, every, touched, arrays, constants, on_exchange);
+}
+
+/// [`resolve_found_contacts`] on a part of the arrays, which hold the balls numbered from
+/// `first` on: of `contacts`, only those that `take` keeps are taken. `take` hears of each
+/// contact, in order, with its balls numbered within the part (an index below `first` wraps
+/// around to a large number); `touched` and `on_exchange` number the balls so too.
+pub fn resolve_found_contacts_in_part(
+    contacts: &[IndexedContact],
+    (first, mut take): (u32, impl FnMut(&IndexedContact, (u32, u32)) -> bool),
+    touched: &mut [bool],
+    (circles, velocities, held): (&mut [Circle], &mut [DVec2], &mut [bool]),
+    constants: (MassModel, f64, f64),
+    on_exchange: impl FnMut(u32, u32, ContactGeometry, Exchange),
+) {
     // Below it the loads cost 1–2% of the discrete step at 1,000 and 10,000 balls.
     let loading_ahead = circles.len() >= PREFETCH_MIN_BALLS;
-    let pairs = contacts.iter().enumerate().map(|(k, contact)| {
-        let (a, b) = (contact.a as usize, contact.b as usize);
-        let untouched = !touched[a] && !touched[b];
-        (touched[a], touched[b]) = (true, true);
+    let in_part =
+        |contact: &IndexedContact| (contact.a.wrapping_sub(first), contact.b.wrapping_sub(first));
+    let pairs = contacts.iter().enumerate().filter_map(|(k, contact)| {
+        let (a, b) = in_part(contact);
+        if !take(contact, (a, b)) {
+            return None;
+        }
+        let (ia, ib) = (a as usize, b as usize);
+        let untouched = !touched[ia] && !touched[ib];
+        (touched[ia], touched[ib]) = (true, true);
         let coming = contacts
             .get(k + PREFETCH_DISTANCE)
             .filter(|_| loading_ahead)
-            .map(|coming| (coming.a, coming.b));
+            .map(in_part);
         let known = untouched.then_some(contact.geometry);
-        (contact.a, contact.b, known, coming)
+        Some((a, b, known, coming))
     });
     resolve_known_overlaps(pairs, circles, velocities, held, constants, on_exchange);
 }

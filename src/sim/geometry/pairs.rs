@@ -8,7 +8,7 @@ use crossbeam_utils::CachePadded;
 
 use super::circle::{Circle, ContactGeometry, circle_contact, circles_touch};
 use super::grid::{UniformGrid, for_each_pair};
-use crate::sim::parallel::{compute_pool, split_evenly, threads_at_work, worth_splitting};
+use crate::sim::parallel::{in_pieces, split_evenly, threads_at_work, worth_splitting};
 use crate::sim::params::BroadPhase;
 
 /// A contact between balls `a < b`, numbered by their position in the input slice.
@@ -31,11 +31,17 @@ pub struct FoundInBands<T> {
     /// Each band's buffer on cache lines of its own: the threads push to their bands at once,
     /// and two buffers' lengths on one line would pass it back and forth between the cores.
     bands: Vec<CachePadded<Vec<T>>>,
+    /// Each band's first row of the grid's cells (one band, from row 0, when the search was
+    /// not by rows).
+    first_rows: Vec<usize>,
 }
 
 impl<T> Default for FoundInBands<T> {
     fn default() -> Self {
-        Self { bands: Vec::new() }
+        Self {
+            bands: Vec::new(),
+            first_rows: Vec::new(),
+        }
     }
 }
 
@@ -48,6 +54,13 @@ impl<T> FoundInBands<T> {
     /// The bands' pairs, band after band.
     pub fn bands(&self) -> impl Iterator<Item = &[T]> {
         self.bands.iter().map(|band| band.as_slice())
+    }
+
+    /// The bands' pairs, band after band, each with the first row of the grid's cells its
+    /// band searched: a band of rows `r..s` finds pairs of balls in rows `r..=s` (a ball's
+    /// candidates are in its own row and the row above), and the big balls.
+    pub fn bands_from_rows(&self) -> impl Iterator<Item = (usize, &[T])> {
+        self.first_rows.iter().copied().zip(self.bands())
     }
 
     /// How many pairs were found.
@@ -65,11 +78,21 @@ impl<T> FoundInBands<T> {
         self.bands.iter_mut().for_each(|band| band.clear());
     }
 
-    /// Empties every band and keeps `count` of them (at least one), their buffers kept.
-    fn clear_to(&mut self, count: usize) -> &mut [CachePadded<Vec<T>>] {
-        self.bands.truncate(count.max(1));
+    /// Empties every band and keeps one for each of `band_rows` (at least one, from row 0),
+    /// their buffers kept.
+    fn clear_to(
+        &mut self,
+        band_rows: impl Iterator<Item = Range<usize>>,
+    ) -> &mut [CachePadded<Vec<T>>] {
+        self.first_rows.clear();
+        self.first_rows.extend(band_rows.map(|rows| rows.start));
+        if self.first_rows.is_empty() {
+            self.first_rows.push(0);
+        }
+        let count = self.first_rows.len();
+        self.bands.truncate(count);
         self.clear();
-        self.bands.resize_with(count.max(1), CachePadded::default);
+        self.bands.resize_with(count, CachePadded::default);
         &mut self.bands
     }
 }
@@ -87,12 +110,15 @@ pub fn find_contacts(
     match method {
         BroadPhase::Grid => {
             grid.rebuild(circles);
-            let bands = found.clear_to(band_count(grid));
+            let bands = found.clear_to(band_rows(grid));
             search_bands(grid, bands, |grid, rows, local| {
                 grid.for_each_touching_pair_in_rows(rows, keep_touching(local));
             });
         }
-        BroadPhase::AllPairs => for_each_pair(circles, keep_touching(&mut found.clear_to(1)[0])),
+        BroadPhase::AllPairs => {
+            let only = &mut found.clear_to(std::iter::empty())[0];
+            for_each_pair(circles, keep_touching(only));
+        }
     }
 }
 
@@ -164,6 +190,11 @@ fn band_count(grid: &UniformGrid) -> usize {
     }
 }
 
+/// The rows of each of the [`band_count`] bands the grid is searched in.
+fn band_rows(grid: &UniformGrid) -> impl Iterator<Item = Range<usize>> + Clone {
+    split_evenly(grid.rows(), band_count(grid))
+}
+
 /// Runs `search(grid, rows, band)` for each of `bands` over its share of the grid's rows, in
 /// row order, on the compute pool when there is more than one band.
 fn search_bands<T: Send>(
@@ -171,17 +202,13 @@ fn search_bands<T: Send>(
     bands: &mut [CachePadded<Vec<T>>],
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
-    let rows = grid.rows();
     if let [only] = bands {
-        search(grid, 0..rows, only);
+        search(grid, 0..grid.rows(), only);
         return;
     }
-    let search = &search;
-    let band_rows = split_evenly(rows, bands.len());
-    compute_pool().scope(|scope| {
-        for (band_rows, local) in band_rows.zip(bands) {
-            scope.spawn(async move { search(grid, band_rows, local) });
-        }
+    let band_rows = split_evenly(grid.rows(), bands.len());
+    in_pieces(band_rows.zip(bands), true, |(rows, local)| {
+        search(grid, rows, local);
     });
 }
 

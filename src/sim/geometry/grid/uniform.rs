@@ -244,6 +244,21 @@ impl UniformGrid {
         self.cells.rows
     }
 
+    /// The row of cells the ball of `index` (in the slice given to [`rebuild`](Self::rebuild))
+    /// is filed in, or `None` for a big ball, which has no cell. Not after
+    /// [`renumber_by_slot`](Self::renumber_by_slot), which numbers the balls otherwise.
+    pub fn row_of_ball(&self, index: usize) -> Option<usize> {
+        let cell = self.cell_of[index];
+        (cell != NO_CELL).then(|| cell as usize / self.cells.columns)
+    }
+
+    /// The first slot of the balls in the cells of `row` and the rows after it: how many balls
+    /// in the cells lie in the rows before it (all of them for a row past the last).
+    pub fn first_slot_of_row(&self, row: usize) -> usize {
+        let cell = (row * self.cells.columns).min(self.cells.cell_count());
+        self.cell_start.get(cell).map_or(0, |&slot| slot as usize)
+    }
+
     /// A radius above this is big (see the header): a caller filing its own circles by this
     /// grid's cells keeps those apart too.
     pub fn big_limit(&self) -> f64 {
