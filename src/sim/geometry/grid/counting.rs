@@ -12,11 +12,15 @@ use crate::sim::parallel::{carve, in_pieces, split_evenly, threads_at_work};
 pub const NO_CELL: u32 = u32::MAX;
 
 /// Below this many balls the sort is one band, threads or not: every band reads every ball,
-/// and while the buffers fit in a core's cache one band is faster than two (the standard gas
-/// on this project's two cores, ms a step for the sort, one band against two: 0.32 against
-/// 0.45–0.56 at 100,000 balls, 0.70–0.71 against 0.73–0.93 at 200,000, 1.35–1.71 against
-/// 1.19–1.46 at 300,000, 1.86–2.15 against 1.46–1.54 at 400,000).
-const BANDED_SORT_MIN_BALLS: usize = 250_000;
+/// and while the buffers (about 13 bytes a ball) fit in a core's 1 MB cache one band is as
+/// fast as two. The standard gas on this project's two cores, the whole step on two threads,
+/// two bands against one, alternate steps of one run (three to six runs of 400 steps a
+/// size): 1.00–1.05× at 30,000 and 50,000 balls, 0.97–1.02× at 75,000, 0.95–1.02× (most
+/// 0.95–0.96×) at 100,000. (Before the calling thread took its pieces itself and spun at the
+/// join, each pass's join cost up to 50 µs, and the sort alone took 0.32 ms in one band
+/// against 0.45–0.56 in two at 100,000 balls, 0.70 against 0.73–0.93 at 200,000, 1.35–1.71
+/// against 1.19–1.46 at 300,000: the limit was 250,000.)
+const BANDED_SORT_MIN_BALLS: usize = 75_000;
 
 /// The bands of cells to sort `balls` balls in when the work is split (`parallel`) or not:
 /// one for each thread at work from [`BANDED_SORT_MIN_BALLS`] balls, else one.
