@@ -78,15 +78,12 @@ impl ExchangesInParts {
         let count = circles.len();
         self.waits.resize(count, false);
         self.waiting.resize_with(parts.len(), Vec::new);
-        let ranges: Vec<_> = parts
+        let ends = parts
             .iter()
-            .zip(
-                parts
-                    .iter()
-                    .skip(1)
-                    .map(|next| next.first_ball)
-                    .chain([count]),
-            )
+            .skip(1)
+            .map(|next| next.first_ball)
+            .chain([count]);
+        let ranges: Vec<_> = (parts.iter().zip(ends))
             .map(|(part, end)| part.first_ball..end)
             .collect();
         let carved = || ranges.iter().cloned();
@@ -99,32 +96,32 @@ impl ExchangesInParts {
             .zip(carve(&mut self.waits, carved()))
             .zip(&mut self.waiting)
             .zip(arrays);
-        let rows = |index: usize| grid.row_of_ball(index);
+        let row_of = |index: usize| grid.row_of_ball(index);
         let exchanges_at_once = in_pieces(
             work,
             parts.len() > 1,
             |(((part, waits), waiting), (((touched, circles), velocities), held))| {
                 waiting.clear();
                 let mut exchanges = 0;
-                let count = |_, _, _, _| exchanges += 1;
+                let count_exchange = |_, _, _, _| exchanges += 1;
                 let arrays = (circles, velocities, held);
+                let waits = (waits, waiting);
                 take_at_once(
-                    part,
-                    rows,
-                    (waits, waiting),
+                    (part, row_of),
+                    waits,
                     touched,
                     arrays,
                     constants,
-                    count,
+                    count_exchange,
                 );
                 exchanges
             },
         );
         let mut exchanges: u64 = exchanges_at_once.iter().sum();
         let arrays = (&mut circles[..], &mut velocities[..], &mut held[..]);
-        let count = |_, _, _, _| exchanges += 1;
+        let count_exchange = |_, _, _, _| exchanges += 1;
         let waiting: Vec<IndexedContact> = self.waiting.iter().flatten().copied().collect();
-        resolve_found_contacts(&waiting, touched, arrays, constants, count);
+        resolve_found_contacts(&waiting, touched, arrays, constants, count_exchange);
         for contact in &waiting {
             self.waits[contact.a as usize] = false;
             self.waits[contact.b as usize] = false;
@@ -169,8 +166,7 @@ fn cut_into_parts<'a>(
 /// free unless it `waits`, or its row by `row_of(index)` (`None` for a big ball) is not past
 /// the part's first row.
 fn take_at_once(
-    part: &Part,
-    row_of: impl Fn(usize) -> Option<usize>,
+    (part, row_of): (&Part, impl Fn(usize) -> Option<usize>),
     (waits, waiting): (&mut [bool], &mut Vec<IndexedContact>),
     touched: &mut [bool],
     (circles, velocities, held): (&mut [Circle], &mut [DVec2], &mut [bool]),
