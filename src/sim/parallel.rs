@@ -31,7 +31,10 @@ pub fn piece_ranges(count: usize) -> impl Iterator<Item = Range<usize>> + Clone 
 
 /// `0..count` cut into `parts` consecutive ranges as near equal as can be (some empty when
 /// there are more parts than items): bands of rows or cells for the threads to share.
-pub fn split_evenly(count: usize, parts: usize) -> impl Iterator<Item = Range<usize>> + Clone {
+pub fn split_evenly(
+    count: usize,
+    parts: usize,
+) -> impl ExactSizeIterator<Item = Range<usize>> + Clone {
     (0..parts).map(move |part| count * part / parts..count * (part + 1) / parts)
 }
 

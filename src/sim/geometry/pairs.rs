@@ -110,8 +110,9 @@ pub fn find_contacts(
     match method {
         BroadPhase::Grid => {
             grid.rebuild(circles);
-            let bands = found.clear_to(band_rows(grid));
-            search_bands(grid, bands, |grid, rows, local| {
+            let rows = band_rows(grid);
+            let bands = found.clear_to(rows.clone());
+            search_bands(grid, rows.zip(bands), |grid, rows, local| {
                 grid.for_each_touching_pair_in_rows(rows, keep_touching(local));
             });
         }
@@ -161,7 +162,8 @@ pub fn search_in_bands<T: Send + 'static>(
     found: &mut Vec<T>,
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
-    let band_count = band_count(grid);
+    let rows = band_rows(grid);
+    let band_count = rows.len();
     if band_count == 1 {
         search(grid, 0..grid.rows(), found);
         return;
@@ -173,7 +175,7 @@ pub fn search_in_bands<T: Send + 'static>(
     let mut bands: Vec<CachePadded<Vec<T>>> = (0..band_count)
         .map(|_| CachePadded::new(Vec::with_capacity(share + share / 8)))
         .collect();
-    search_bands(grid, &mut bands, search);
+    search_bands(grid, rows.zip(&mut bands), search);
     // Exactly what is needed: the buffer is kept from step to step, and doubling it would
     // leave up to half of it unused (megabytes at a million balls).
     found.reserve_exact(bands.iter().map(|band| band.len()).sum());
@@ -191,25 +193,19 @@ fn band_count(grid: &UniformGrid) -> usize {
 }
 
 /// The rows of each of the [`band_count`] bands the grid is searched in.
-fn band_rows(grid: &UniformGrid) -> impl Iterator<Item = Range<usize>> + Clone {
+fn band_rows(grid: &UniformGrid) -> impl ExactSizeIterator<Item = Range<usize>> + Clone {
     split_evenly(grid.rows(), band_count(grid))
 }
 
-/// Runs `search(grid, rows, band)` for each of `bands` over its share of the grid's rows, in
-/// row order, on the compute pool when there is more than one band.
-fn search_bands<T: Send>(
+/// Runs `search(grid, rows, band)` for each band and its rows, in row order, on the compute
+/// pool when there is more than one band.
+fn search_bands<'a, T: Send + 'a>(
     grid: &UniformGrid,
-    bands: &mut [CachePadded<Vec<T>>],
+    bands: impl ExactSizeIterator<Item = (Range<usize>, &'a mut CachePadded<Vec<T>>)>,
     search: impl Fn(&UniformGrid, Range<usize>, &mut Vec<T>) + Sync,
 ) {
-    if let [only] = bands {
-        search(grid, 0..grid.rows(), only);
-        return;
-    }
-    let band_rows = split_evenly(grid.rows(), bands.len());
-    in_pieces(band_rows.zip(bands), true, |(rows, local)| {
-        search(grid, rows, local);
-    });
+    let parallel = bands.len() > 1;
+    in_pieces(bands, parallel, |(rows, band)| search(grid, rows, band));
 }
 
 /// A visitor for the broad phase that runs the narrow phase and keeps touching pairs.
