@@ -83,7 +83,9 @@ impl ExchangesInParts {
             .skip(1)
             .map(|next| next.first_ball)
             .chain([count]);
-        let ranges: Vec<_> = (parts.iter().zip(ends))
+        let ranges: Vec<_> = parts
+            .iter()
+            .zip(ends)
             .map(|(part, end)| part.first_ball..end)
             .collect();
         let carved = || ranges.iter().cloned();
