@@ -2,7 +2,7 @@
 //! median of several rounds of it), and running it, in this process or in a child.
 
 use std::error::Error;
-use std::process::Command;
+use std::process::{Command, Output, Stdio};
 
 use serde::{Deserialize, Serialize};
 
@@ -141,15 +141,41 @@ pub fn peak_rss_mib() -> Option<f64> {
 /// `taskset`), else with a thread per core (the main thread and a worker for each other core).
 pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, Box<dyn Error>> {
     let threads = if one_core { 1 } else { available_cores() };
+    let core = one_core.then_some(0);
+    let output = child(case, core, threads)?
+        .output()
+        .map_err(|e| cannot_start(&e, core))?;
+    result_of_child(output)
+}
+
+/// Runs `case` in one child per core at once, each pinned to its core with one thread (cores
+/// `0..available_cores()`): what a step whose work split perfectly could gain on this machine,
+/// the cores slowing each other only through what they share. The results in the cores' order.
+pub fn run_case_on_each_core(case: BenchCase) -> Result<Vec<CaseResult>, Box<dyn Error>> {
+    let mut children = Vec::new();
+    for core in 0..available_cores() {
+        let spawned = child(case, Some(core), 1)?.spawn();
+        children.push(spawned.map_err(|e| cannot_start(&e, Some(core)))?);
+    }
+    children
+        .into_iter()
+        .map(|child| result_of_child(child.wait_with_output()?))
+        .collect()
+}
+
+/// The `bench-one` child for `case` with `threads` threads, pinned to `core` if given (via
+/// `taskset`), its output captured.
+fn child(case: BenchCase, core: Option<usize>, threads: usize) -> Result<Command, Box<dyn Error>> {
     let exe = std::env::current_exe()?;
-    let mut command = if one_core {
-        let mut taskset = Command::new("taskset");
-        taskset.args(["-c", "0"]).arg(exe);
-        taskset
-    } else {
-        Command::new(exe)
+    let mut command = match core {
+        Some(core) => {
+            let mut taskset = Command::new("taskset");
+            taskset.args(["-c", &core.to_string()]).arg(exe);
+            taskset
+        }
+        None => Command::new(exe),
     };
-    let output = command
+    command
         .args([
             "bench-one",
             "--balls",
@@ -165,17 +191,23 @@ pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, 
             "--collisions",
             &flag_value(case.collisions),
         ])
-        .output()
-        .map_err(|e| {
-            format!(
-                "cannot start the bench child{}: {e}",
-                if one_core {
-                    " (is taskset installed?)"
-                } else {
-                    ""
-                }
-            )
-        })?;
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    Ok(command)
+}
+
+/// Why a child could not start, naming `taskset` when it was to pin one to `core`.
+fn cannot_start(error: &std::io::Error, core: Option<usize>) -> String {
+    let hint = if core.is_some() {
+        " (is taskset installed?)"
+    } else {
+        ""
+    };
+    format!("cannot start the bench child{hint}: {error}")
+}
+
+/// A finished child's result, or its error output.
+fn result_of_child(output: Output) -> Result<CaseResult, Box<dyn Error>> {
     if !output.status.success() {
         return Err(format!(
             "bench child failed: {}",

@@ -1,12 +1,13 @@
 //! One size's row of the bench ([`BenchRow`]): its cases on one core and on all, the
-//! all-pairs reference, the continuous mode, each run in its own child; the row from several
-//! rounds, and the ratios the tables print.
+//! all-pairs reference, the continuous mode, each run in its own child, and if asked the
+//! one-core cases on every core at once ([`OnEachCore`]); the row from several rounds, and the
+//! ratios the tables print.
 
 use std::error::Error;
 
 use serde::Serialize;
 
-use super::case::{BenchCase, CaseResult, run_case_in_child};
+use super::case::{BenchCase, CaseResult, run_case_in_child, run_case_on_each_core};
 use crate::sim::{BroadPhase, CollisionMode};
 
 /// One row of the bench table: a size, on one core and on all cores, against all pairs.
@@ -20,12 +21,29 @@ pub struct BenchRow {
     /// The same gas in continuous mode, on one core and on all.
     pub continuous_one_core: CaseResult,
     pub continuous_all_cores: CaseResult,
+    /// The one-core cases run on every core at once, where asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub on_each_core: Option<OnEachCore>,
+}
+
+/// A size's one-core cases run on every core at once, one child pinned to each: in each mode
+/// the slowest of them, the pace of a step whose work split perfectly over the cores.
+#[derive(Clone, Debug, Serialize)]
+pub struct OnEachCore {
+    pub discrete: CaseResult,
+    pub continuous: CaseResult,
 }
 
 impl BenchRow {
     /// The row of `balls` balls: each case once, `steps` steps, in its own child process; the
-    /// all-pairs reference up to `all_pairs_max` balls.
-    pub fn measure(balls: usize, steps: u64, all_pairs_max: u64) -> Result<Self, Box<dyn Error>> {
+    /// all-pairs reference up to `all_pairs_max` balls; the one-core cases on every core at
+    /// once if `on_each_core`.
+    pub fn measure(
+        balls: usize,
+        steps: u64,
+        all_pairs_max: u64,
+        on_each_core: bool,
+    ) -> Result<Self, Box<dyn Error>> {
         let discrete = BenchCase {
             balls,
             steps,
@@ -50,6 +68,14 @@ impl BenchRow {
                 .transpose()?,
             continuous_one_core: run_case_in_child(continuous, true)?,
             continuous_all_cores: run_case_in_child(continuous, false)?,
+            on_each_core: on_each_core
+                .then(|| -> Result<OnEachCore, Box<dyn Error>> {
+                    Ok(OnEachCore {
+                        discrete: slowest(run_case_on_each_core(discrete)?)?,
+                        continuous: slowest(run_case_on_each_core(continuous)?)?,
+                    })
+                })
+                .transpose()?,
         })
     }
 
@@ -71,6 +97,11 @@ impl BenchRow {
             all_pairs: CaseResult::median_round(all_pairs),
             continuous_one_core: median_of(|row| &row.continuous_one_core)?,
             continuous_all_cores: median_of(|row| &row.continuous_all_cores)?,
+            on_each_core: rounds
+                .iter()
+                .map(|row| row.on_each_core.clone())
+                .collect::<Option<Vec<OnEachCore>>>()
+                .and_then(OnEachCore::median_of_rounds),
         })
     }
 
@@ -88,6 +119,40 @@ impl BenchRow {
     pub fn continuous_speedup_from_cores(&self) -> f64 {
         speedup(&self.continuous_one_core, &self.continuous_all_cores)
     }
+
+    /// What the machine gives a perfectly split step, discrete then continuous, where the
+    /// one-core cases ran on every core at once: as many cores as the all-cores case had,
+    /// times the one-core step alone over the slowest of them.
+    pub fn speedup_on_each_core(&self) -> Option<(f64, f64)> {
+        let each = self.on_each_core.as_ref()?;
+        let cores = self.all_cores.cores as f64;
+        Some((
+            cores * speedup(&self.one_core, &each.discrete),
+            cores * speedup(&self.continuous_one_core, &each.continuous),
+        ))
+    }
+}
+
+impl OnEachCore {
+    /// Each mode's median round; `None` without rounds.
+    fn median_of_rounds(rounds: Vec<OnEachCore>) -> Option<OnEachCore> {
+        let (discrete, continuous) = rounds
+            .into_iter()
+            .map(|each| (each.discrete, each.continuous))
+            .unzip();
+        Some(OnEachCore {
+            discrete: CaseResult::median_round(discrete)?,
+            continuous: CaseResult::median_round(continuous)?,
+        })
+    }
+}
+
+/// The slowest of `results`, by the step's median.
+fn slowest(results: Vec<CaseResult>) -> Result<CaseResult, Box<dyn Error>> {
+    results
+        .into_iter()
+        .max_by(|a, b| a.ms_per_step_median.total_cmp(&b.ms_per_step_median))
+        .ok_or_else(|| "no core to run the bench on".into())
 }
 
 /// How many times faster `faster` ran a step than `slower`.

@@ -83,13 +83,19 @@ pub fn format_table(rows: &[BenchRow]) -> String {
     text + &format_scale(rows)
 }
 
-/// How the cost scales: per ball against the first size, and two cores against one.
+/// How the cost scales: per ball against the first size, and two cores against one; with the
+/// one-core cases run on every core at once, what that gives beside it ("host").
 fn format_scale(rows: &[BenchRow]) -> String {
+    let on_each_core = rows.iter().any(|row| row.on_each_core.is_some());
     let mut text = String::from(
         "\nScale (one core; per ball against the first size, 1.00x is flat; all cores against one):\n",
     );
+    if on_each_core {
+        text += "(host: a one-core run on each core at once, cores x alone / slowest, \
+                 what a perfectly split step could gain)\n";
+    }
     text += &format!(
-        "{:>8} {:>12} {:>13} {:>12} {:>13} {:>9} {:>9}\n",
+        "{:>8} {:>12} {:>13} {:>12} {:>13} {:>9} {:>9}",
         "balls",
         "disc ns/ball",
         "disc vs first",
@@ -98,9 +104,13 @@ fn format_scale(rows: &[BenchRow]) -> String {
         "disc 2c",
         "cont 2c"
     );
+    if on_each_core {
+        text += &format!(" {:>9} {:>9}", "disc host", "cont host");
+    }
+    text += "\n";
     for (row, (discrete, continuous)) in rows.iter().zip(cost_per_ball_against_first(rows)) {
         text += &format!(
-            "{:>8} {:>12.1} {:>12.2}x {:>12.1} {:>12.2}x {:>8.2}x {:>8.2}x\n",
+            "{:>8} {:>12.1} {:>12.2}x {:>12.1} {:>12.2}x {:>8.2}x {:>8.2}x",
             row.balls,
             row.one_core.ns_per_ball_step,
             discrete,
@@ -109,6 +119,13 @@ fn format_scale(rows: &[BenchRow]) -> String {
             row.speedup_from_cores(),
             row.continuous_speedup_from_cores(),
         );
+        if on_each_core {
+            text += &match row.speedup_on_each_core() {
+                Some((discrete, continuous)) => format!(" {discrete:>8.2}x {continuous:>8.2}x"),
+                None => format!(" {:>9} {:>9}", "-", "-"),
+            };
+        }
+        text += "\n";
     }
     text
 }
@@ -117,19 +134,20 @@ fn format_scale(rows: &[BenchRow]) -> String {
 mod tests {
     use super::*;
     use crate::commands::bench::case::{BenchCase, CaseResult};
+    use crate::commands::bench::rows::OnEachCore;
     use crate::sim::{BroadPhase, CollisionMode};
 
-    #[test]
-    fn the_cost_per_ball_is_taken_against_the_first_size() {
-        let result = |balls: usize, collisions, ms: f64| CaseResult {
+    /// A case of `balls` balls whose step took `ms`, on `cores` cores with as many threads.
+    fn result(balls: usize, collisions: CollisionMode, cores: usize, ms: f64) -> CaseResult {
+        CaseResult {
             case: BenchCase {
                 balls,
                 steps: 10,
                 broad_phase: BroadPhase::Grid,
                 collisions,
             },
-            cores: 1,
-            threads: 1,
+            cores,
+            threads: cores,
             ms_per_step_median: ms,
             ms_per_step_p10: ms,
             ns_per_ball_step: ms * 1e6 / balls as f64,
@@ -139,14 +157,19 @@ mod tests {
             collisions_per_cpu_second: 0.0,
             peak_rss_mib: None,
             rounds_ms_per_step: Vec::new(),
-        };
+        }
+    }
+
+    #[test]
+    fn the_cost_per_ball_is_taken_against_the_first_size() {
         let row = |balls, discrete_ms, continuous_ms| BenchRow {
             balls,
-            one_core: result(balls, CollisionMode::Discrete, discrete_ms),
-            all_cores: result(balls, CollisionMode::Discrete, discrete_ms / 1.5),
+            one_core: result(balls, CollisionMode::Discrete, 1, discrete_ms),
+            all_cores: result(balls, CollisionMode::Discrete, 1, discrete_ms / 1.5),
             all_pairs: None,
-            continuous_one_core: result(balls, CollisionMode::Continuous, continuous_ms),
-            continuous_all_cores: result(balls, CollisionMode::Continuous, continuous_ms),
+            continuous_one_core: result(balls, CollisionMode::Continuous, 1, continuous_ms),
+            continuous_all_cores: result(balls, CollisionMode::Continuous, 1, continuous_ms),
+            on_each_core: None,
         };
         // 10x the balls: discrete 13x the time (1.3x a ball), continuous 20x (2x a ball).
         let rows = [row(100_000, 10.0, 30.0), row(1_000_000, 130.0, 600.0)];
@@ -211,6 +234,7 @@ mod tests {
             all_pairs: None,
             continuous_one_core: median.clone(),
             continuous_all_cores: median,
+            on_each_core: None,
         }];
         assert!(format_table(&rows).starts_with("Each case: its median of 3 rounds"));
         // A size's rows from rounds: each case from its own rounds, no all-pairs if none ran.
@@ -221,6 +245,7 @@ mod tests {
             all_pairs: (k == 0.0).then(|| round(9.0, 40.0)),
             continuous_one_core: round(3.0 + k, 40.0),
             continuous_all_cores: round(4.0 + k, 40.0),
+            on_each_core: None,
         };
         let row = BenchRow::median_of_rounds([0.3, 0.1, 0.2].map(row_of_round).to_vec()).unwrap();
         let ms = |case: &CaseResult| case.ms_per_step_median;
@@ -232,5 +257,52 @@ mod tests {
         let with_all_pairs = BenchRow::median_of_rounds(vec![row_of_round(0.0)]).unwrap();
         assert_eq!(with_all_pairs.all_pairs.map(|case| ms(&case)), Some(9.0));
         assert!(BenchRow::median_of_rounds(Vec::new()).is_none());
+    }
+
+    #[test]
+    fn the_host_figure_is_the_cores_times_one_core_alone_over_the_slowest_on_each_core() {
+        let result = |collisions, cores, ms| result(100_000, collisions, cores, ms);
+        let (discrete, continuous) = (CollisionMode::Discrete, CollisionMode::Continuous);
+        // One core alone 10 and 30 ms; on each of two cores at once, the slowest 11 and 40.
+        let row = |each: Option<(f64, f64)>| BenchRow {
+            balls: 100_000,
+            one_core: result(discrete, 1, 10.0),
+            all_cores: result(discrete, 2, 6.0),
+            all_pairs: None,
+            continuous_one_core: result(continuous, 1, 30.0),
+            continuous_all_cores: result(continuous, 2, 20.0),
+            on_each_core: each.map(|(discrete_ms, continuous_ms)| OnEachCore {
+                discrete: result(discrete, 1, discrete_ms),
+                continuous: result(continuous, 1, continuous_ms),
+            }),
+        };
+        let measured = row(Some((11.0, 40.0)));
+        let (host_discrete, host_continuous) = measured.speedup_on_each_core().unwrap();
+        assert!(
+            (host_discrete - 20.0 / 11.0).abs() < 1e-12,
+            "{host_discrete}"
+        );
+        assert!((host_continuous - 1.5).abs() < 1e-12, "{host_continuous}");
+        assert_eq!(row(None).speedup_on_each_core(), None);
+        let table = format_table(&[measured.clone(), row(None)]);
+        assert!(
+            table.contains("disc host") && table.contains("cont host"),
+            "{table}"
+        );
+        let last_line = |table: &str| table.lines().last().unwrap_or("").to_string();
+        assert!(
+            table.contains("1.82x     1.50x") && last_line(&table).ends_with("-         -"),
+            "{table}"
+        );
+        assert!(!format_table(&[row(None)]).contains("host"));
+        // From rounds: each mode's median round, and none unless every round ran them.
+        let rounds = [(13.0, 42.0), (11.0, 40.0), (12.0, 44.0)].map(|each| row(Some(each)));
+        let median = BenchRow::median_of_rounds(rounds.to_vec()).unwrap();
+        let each = median.on_each_core.unwrap();
+        assert_eq!(each.discrete.ms_per_step_median, 12.0);
+        assert_eq!(each.continuous.ms_per_step_median, 42.0);
+        assert_eq!(each.discrete.rounds_ms_per_step, [13.0, 11.0, 12.0]);
+        let missing = BenchRow::median_of_rounds(vec![measured, row(None)]).unwrap();
+        assert!(missing.on_each_core.is_none());
     }
 }
