@@ -113,9 +113,9 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 3, conflicts_with_all = ["pile", "mixed"],
           value_parser = clap::value_parser!(u64).range(1..=100))]
     pub rounds: u64,
-    /// Also run each size's one-core cases on every core at once (one child pinned to each):
-    /// what a perfectly split step could gain on this machine, printed beside the two-core
-    /// figures as "host".
+    /// Also run each size's one-core cases on every core, one child pinned to each (cores 0,
+    /// 1, ...), started together: what a perfectly split step could gain on this machine,
+    /// printed beside the all-core figures ("2c") as "host".
     #[arg(long, conflicts_with_all = ["pile", "mixed"])]
     pub on_each_core: bool,
     /// Print the rows as JSON instead of a table.

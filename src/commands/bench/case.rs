@@ -1,8 +1,9 @@
 //! One bench case: what it runs ([`BenchCase`]), what it measured ([`CaseResult`], and the
-//! median of several rounds of it), and running it, in this process or in a child.
+//! median of several rounds of it), and running it, in this process, in a child, or in one
+//! child on each core started together.
 
 use std::error::Error;
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 
 use serde::{Deserialize, Serialize};
 
@@ -142,30 +143,51 @@ pub fn peak_rss_mib() -> Option<f64> {
 pub fn run_case_in_child(case: BenchCase, one_core: bool) -> Result<CaseResult, Box<dyn Error>> {
     let threads = if one_core { 1 } else { available_cores() };
     let core = one_core.then_some(0);
-    let output = child(case, core, threads)?
+    let output = bench_one_command(case, core, threads)?
         .output()
         .map_err(|e| cannot_start(&e, core))?;
-    result_of_child(output)
+    result_of_child(output, core)
 }
 
-/// Runs `case` in one child per core at once, each pinned to its core with one thread (cores
-/// `0..available_cores()`): what a step whose work split perfectly could gain on this machine,
-/// the cores slowing each other only through what they share. The results in the cores' order.
+/// Runs `case` in one child per core, started together, each pinned to its core with one
+/// thread (cores `0..available_cores()`, so the process should not be held to other cores):
+/// what a step whose work split perfectly could gain on this machine, the cores slowing each
+/// other only through what they share. The results in the cores' order. Every child started is
+/// waited for, or stopped if another cannot start, before an error is returned.
 pub fn run_case_on_each_core(case: BenchCase) -> Result<Vec<CaseResult>, Box<dyn Error>> {
-    let mut children = Vec::new();
+    let mut children: Vec<Child> = Vec::new();
     for core in 0..available_cores() {
-        let spawned = child(case, Some(core), 1)?.spawn();
-        children.push(spawned.map_err(|e| cannot_start(&e, Some(core)))?);
+        let started = bench_one_command(case, Some(core), 1).and_then(|mut command| {
+            command
+                .spawn()
+                .map_err(|e| cannot_start(&e, Some(core)).into())
+        });
+        match started {
+            Ok(child) => children.push(child),
+            Err(error) => {
+                for mut child in children {
+                    // Stopping a child that has already ended is no error worth reporting.
+                    let _ = child.kill();
+                    let _ = child.wait();
+                }
+                return Err(error);
+            }
+        }
     }
-    children
-        .into_iter()
-        .map(|child| result_of_child(child.wait_with_output()?))
+    let outputs: Vec<_> = children.into_iter().map(Child::wait_with_output).collect();
+    (0..)
+        .zip(outputs)
+        .map(|(core, output)| result_of_child(output?, Some(core)))
         .collect()
 }
 
-/// The `bench-one` child for `case` with `threads` threads, pinned to `core` if given (via
-/// `taskset`), its output captured.
-fn child(case: BenchCase, core: Option<usize>, threads: usize) -> Result<Command, Box<dyn Error>> {
+/// The `bench-one` child process for `case` with `threads` threads, pinned to `core` if given
+/// (via `taskset`), its output captured.
+fn bench_one_command(
+    case: BenchCase,
+    core: Option<usize>,
+    threads: usize,
+) -> Result<Command, Box<dyn Error>> {
     let exe = std::env::current_exe()?;
     let mut command = match core {
         Some(core) => {
@@ -206,11 +228,14 @@ fn cannot_start(error: &std::io::Error, core: Option<usize>) -> String {
     format!("cannot start the bench child{hint}: {error}")
 }
 
-/// A finished child's result, or its error output.
-fn result_of_child(output: Output) -> Result<CaseResult, Box<dyn Error>> {
+/// A finished child's result, or how it ended and its error output (`core`: where it was
+/// pinned, if it was).
+fn result_of_child(output: Output, core: Option<usize>) -> Result<CaseResult, Box<dyn Error>> {
     if !output.status.success() {
+        let place = core.map_or(String::new(), |core| format!(" on core {core}"));
         return Err(format!(
-            "bench child failed: {}",
+            "bench child{place} failed ({}): {}",
+            output.status,
             String::from_utf8_lossy(&output.stderr)
         )
         .into());

@@ -26,10 +26,12 @@ pub struct BenchRow {
     pub on_each_core: Option<OnEachCore>,
 }
 
-/// A size's one-core cases run on every core at once, one child pinned to each: in each mode
-/// the slowest of them, the pace of a step whose work split perfectly over the cores.
+/// A size's one-core cases run on every core, one child pinned to each, started together: in
+/// each mode the slowest of them, the pace of a step whose work split perfectly over the cores.
 #[derive(Clone, Debug, Serialize)]
 pub struct OnEachCore {
+    /// How many ran side by side.
+    pub cores: usize,
     pub discrete: CaseResult,
     pub continuous: CaseResult,
 }
@@ -69,12 +71,7 @@ impl BenchRow {
             continuous_one_core: run_case_in_child(continuous, true)?,
             continuous_all_cores: run_case_in_child(continuous, false)?,
             on_each_core: on_each_core
-                .then(|| -> Result<OnEachCore, Box<dyn Error>> {
-                    Ok(OnEachCore {
-                        discrete: slowest(run_case_on_each_core(discrete)?)?,
-                        continuous: slowest(run_case_on_each_core(continuous)?)?,
-                    })
-                })
+                .then(|| OnEachCore::measure(discrete, continuous))
                 .transpose()?,
         })
     }
@@ -121,11 +118,11 @@ impl BenchRow {
     }
 
     /// What the machine gives a perfectly split step, discrete then continuous, where the
-    /// one-core cases ran on every core at once: as many cores as the all-cores case had,
-    /// times the one-core step alone over the slowest of them.
+    /// one-core cases ran on every core: as many as ran side by side, times the one-core step
+    /// alone over the slowest of them.
     pub fn speedup_on_each_core(&self) -> Option<(f64, f64)> {
         let each = self.on_each_core.as_ref()?;
-        let cores = self.all_cores.cores as f64;
+        let cores = each.cores as f64;
         Some((
             cores * speedup(&self.one_core, &each.discrete),
             cores * speedup(&self.continuous_one_core, &each.continuous),
@@ -134,13 +131,25 @@ impl BenchRow {
 }
 
 impl OnEachCore {
+    /// The `discrete` and `continuous` cases, each run on every core, one child pinned to each.
+    fn measure(discrete: BenchCase, continuous: BenchCase) -> Result<Self, Box<dyn Error>> {
+        let discrete = run_case_on_each_core(discrete)?;
+        Ok(OnEachCore {
+            cores: discrete.len(),
+            discrete: slowest(discrete)?,
+            continuous: slowest(run_case_on_each_core(continuous)?)?,
+        })
+    }
+
     /// Each mode's median round; `None` without rounds.
     fn median_of_rounds(rounds: Vec<OnEachCore>) -> Option<OnEachCore> {
+        let cores = rounds.first()?.cores;
         let (discrete, continuous) = rounds
             .into_iter()
             .map(|each| (each.discrete, each.continuous))
             .unzip();
         Some(OnEachCore {
+            cores,
             discrete: CaseResult::median_round(discrete)?,
             continuous: CaseResult::median_round(continuous)?,
         })
@@ -148,7 +157,7 @@ impl OnEachCore {
 }
 
 /// The slowest of `results`, by the step's median.
-fn slowest(results: Vec<CaseResult>) -> Result<CaseResult, Box<dyn Error>> {
+pub(super) fn slowest(results: Vec<CaseResult>) -> Result<CaseResult, Box<dyn Error>> {
     results
         .into_iter()
         .max_by(|a, b| a.ms_per_step_median.total_cmp(&b.ms_per_step_median))

@@ -134,7 +134,7 @@ fn format_scale(rows: &[BenchRow]) -> String {
 mod tests {
     use super::*;
     use crate::commands::bench::case::{BenchCase, CaseResult};
-    use crate::commands::bench::rows::OnEachCore;
+    use crate::commands::bench::rows::{OnEachCore, slowest};
     use crate::sim::{BroadPhase, CollisionMode};
 
     /// A case of `balls` balls whose step took `ms`, on `cores` cores with as many threads.
@@ -272,6 +272,7 @@ mod tests {
             continuous_one_core: result(continuous, 1, 30.0),
             continuous_all_cores: result(continuous, 2, 20.0),
             on_each_core: each.map(|(discrete_ms, continuous_ms)| OnEachCore {
+                cores: 2,
                 discrete: result(discrete, 1, discrete_ms),
                 continuous: result(continuous, 1, continuous_ms),
             }),
@@ -304,5 +305,16 @@ mod tests {
         assert_eq!(each.discrete.rounds_ms_per_step, [13.0, 11.0, 12.0]);
         let missing = BenchRow::median_of_rounds(vec![measured, row(None)]).unwrap();
         assert!(missing.on_each_core.is_none());
+        assert!(
+            !serde_json::to_string(&row(None))
+                .unwrap()
+                .contains("on_each_core")
+        );
+        // Of the runs side by side, the slowest; of none, an error.
+        let side_by_side = [11.0, 13.0, 12.0]
+            .map(|ms| result(discrete, 1, ms))
+            .to_vec();
+        assert_eq!(slowest(side_by_side).unwrap().ms_per_step_median, 13.0);
+        assert!(slowest(Vec::new()).is_err());
     }
 }
