@@ -49,6 +49,12 @@ impl CellMap {
         }
     }
 
+    /// Where `point` lies, in cells from the origin: its cell's column and row are the whole
+    /// parts.
+    pub fn position_in_cells(&self, point: DVec2) -> DVec2 {
+        (point - self.origin) * self.inverse_cell_size
+    }
+
     /// The side of a cell.
     pub fn cell_size(&self) -> f64 {
         1.0 / self.inverse_cell_size

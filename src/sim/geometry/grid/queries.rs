@@ -13,6 +13,15 @@ use super::uniform::UniformGrid;
 use crate::sim::cache::prefetch;
 use crate::sim::geometry::circle::Circle;
 
+/// From this many balls the loads ahead of a query cover four rows of four cells, every cache
+/// line of each row, rather than three rows of three cells and their first two lines. At a
+/// million balls the continuous search after an impact reads 0.2 rows a search outside the
+/// three rows around the ball's cell (its box follows the balls' current circles, not their
+/// cells). Below this count the extra loads cost more than they save. The continuous gas, one
+/// thread, in turn (docs/performance.md, twenty-eighth session): a million balls −3 to −4%
+/// (three rounds), 700,000 −3% (two); 400,000 +3% (two, an earlier cut of the same loads).
+const WIDE_LOADS_MIN_BALLS: usize = 700_000;
+
 impl UniformGrid {
     /// Calls `visit(cells)` with runs of consecutive cell indices that together cover every
     /// cell overlapping the box `[min, max]`: one run per row.
@@ -60,27 +69,67 @@ impl UniformGrid {
     }
 
     /// Brings where each row of cells around the ball in `slot` (its cell's row and the rows
-    /// beside it, three cells wide) starts into the cache: what
+    /// beside it, three cells wide; four rows of four, and where each ends, for many balls:
+    /// [`WIDE_LOADS_MIN_BALLS`]) starts into the cache: what
     /// [`prefetch_cells_around`](Self::prefetch_cells_around) reads. Best some time after
     /// [`prefetch_slot`](Self::prefetch_slot), which brings the ball's cell, read here.
+    #[inline]
     pub fn prefetch_cell_starts_around(&self, slot: usize) {
+        if self.loads_wide() {
+            self.load_wide_cell_starts_around(slot);
+            return;
+        }
         for cells in self.cell_runs_around(slot) {
             prefetch(self.cell_start.get(cells.start));
         }
     }
 
+    /// [`prefetch_cell_starts_around`](Self::prefetch_cell_starts_around) for many balls:
+    /// where each row of the wider region starts and ends.
+    #[inline(never)]
+    fn load_wide_cell_starts_around(&self, slot: usize) {
+        for cells in self.wide_cell_runs_around(slot) {
+            prefetch(self.cell_start.get(cells.start));
+            prefetch(self.cell_start.get(cells.end));
+        }
+    }
+
+    /// Whether the loads ahead cover the wider region ([`WIDE_LOADS_MIN_BALLS`]).
+    fn loads_wide(&self) -> bool {
+        self.len() >= WIDE_LOADS_MIN_BALLS
+    }
+
     /// Brings the first circles of each row of cells around the ball in `slot` (its cell's
-    /// row and the rows beside it, three cells wide) into the cache, as
+    /// row and the rows beside it, three cells wide; every circle's line of four rows of four
+    /// for many balls: [`WIDE_LOADS_MIN_BALLS`]) into the cache, as
     /// [`prefetch_slot`](Self::prefetch_slot) does: where a query around the ball will read.
     /// A row of three cells holds four or five circles of the gas, 24 B each: the first and
     /// the fourth fall in its first two cache lines. Best some time after
     /// [`prefetch_cell_starts_around`](Self::prefetch_cell_starts_around), which brings what
     /// is read here.
+    #[inline]
     pub fn prefetch_cells_around(&self, slot: usize) {
+        if self.loads_wide() {
+            self.load_wide_cells_around(slot);
+            return;
+        }
         for cells in self.cell_runs_around(slot) {
             let first_slot = self.cell_start.get(cells.start).map(|&slot| slot as usize);
             for offset in [0, 3] {
                 prefetch(first_slot.and_then(|slot| self.sorted_circle.get(slot + offset)));
+            }
+        }
+    }
+
+    /// [`prefetch_cells_around`](Self::prefetch_cells_around) for many balls: every line of
+    /// the circles of each row of the wider region.
+    #[inline(never)]
+    fn load_wide_cells_around(&self, slot: usize) {
+        for cells in self.wide_cell_runs_around(slot) {
+            let slots = self.slots_of(cells);
+            // Every other circle of 24 B, and the last, falls in each of the run's lines.
+            for slot in slots.clone().step_by(2).chain(slots.end.checked_sub(1)) {
+                prefetch(self.sorted_circle.get(slot));
             }
         }
     }
@@ -92,15 +141,9 @@ impl UniformGrid {
     /// [`for_each_cell_run_in_box`](Self::for_each_cell_run_in_box): that was 3% slower at a
     /// million balls (seven rounds).
     fn cell_runs_around(&self, slot: usize) -> impl Iterator<Item = Range<usize>> + use<> {
-        let cell = self
-            .cell_of
-            .get(slot)
-            .copied()
-            .filter(|&cell| cell != NO_CELL);
+        let cell = self.cell_in_row_and_column(slot);
+        let (row, column) = cell.unwrap_or((0, 0));
         let (columns, rows) = (self.cells.columns, self.cells.rows);
-        let (row, column) = cell.map_or((0, 0), |cell| {
-            (cell as usize / columns, cell as usize % columns)
-        });
         let near_rows = if cell.is_some() {
             row.saturating_sub(1)..(row + 2).min(rows)
         } else {
@@ -109,6 +152,43 @@ impl UniformGrid {
         let near_columns = column.saturating_sub(1)..(column + 2).min(columns);
         near_rows
             .map(move |row| row * columns + near_columns.start..row * columns + near_columns.end)
+    }
+
+    /// [`cell_runs_around`](Self::cell_runs_around)'s three rows of three cells and the row and
+    /// the column beyond them on the side of the ball's cell where its current circle's centre
+    /// lies: four rows of four cells (fewer at the grid's edges).
+    fn wide_cell_runs_around(&self, slot: usize) -> impl Iterator<Item = Range<usize>> + use<> {
+        let cell = self.cell_in_row_and_column(slot);
+        let (row, column) = cell.unwrap_or((0, 0));
+        let (columns, rows) = (self.cells.columns, self.cells.rows);
+        let within = self.sorted_circle.get(slot).map_or(DVec2::ZERO, |circle| {
+            self.cells.position_in_cells(circle.center)
+        });
+        // Two back if the centre lies in the lower half of its cell, along each axis.
+        let around = |at: usize, within: f64, count: usize| {
+            let back = if within - at as f64 >= 0.5 { 1 } else { 2 };
+            at.saturating_sub(back)..(at + 4 - back).min(count)
+        };
+        let near_rows = if cell.is_some() {
+            around(row, within.y, rows)
+        } else {
+            0..0
+        };
+        let near_columns = around(column, within.x, columns);
+        near_rows
+            .map(move |row| row * columns + near_columns.start..row * columns + near_columns.end)
+    }
+
+    /// The row and column of the cell of the ball in `slot`: none for a big ball, or a slot past
+    /// the last.
+    fn cell_in_row_and_column(&self, slot: usize) -> Option<(usize, usize)> {
+        let columns = self.cells.columns;
+        let cell = self
+            .cell_of
+            .get(slot)
+            .copied()
+            .filter(|&cell| cell != NO_CELL)?;
+        Some((cell as usize / columns, cell as usize % columns))
     }
 
     /// The balls in the cells that overlap the box `[min, max]`.
@@ -138,6 +218,50 @@ mod tests {
                 Circle::new(DVec2::new(x, y), 1.0 + (i % 5) as f64)
             })
             .collect()
+    }
+
+    #[test]
+    fn the_wide_loads_ahead_hold_the_narrow_ones_and_reach_towards_the_ball_s_circle() {
+        let circles = scattered();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut order = Vec::new();
+        grid.renumber_by_slot(&mut order);
+        let (columns, rows) = (grid.cells.columns, grid.cells.rows);
+        assert!(columns > 8 && rows > 8, "{columns} x {rows} cells");
+        let cells_of = |slot: usize, wide: bool| -> Vec<usize> {
+            if wide {
+                grid.wide_cell_runs_around(slot).flatten().collect()
+            } else {
+                grid.cell_runs_around(slot).flatten().collect()
+            }
+        };
+        let mut reached = [0; 2];
+        for slot in 0..grid.small_count() {
+            let (narrow, wide) = (cells_of(slot, false), cells_of(slot, true));
+            assert!(narrow.iter().all(|cell| wide.contains(cell)), "slot {slot}");
+            assert!(narrow.len() <= 9 && wide.len() <= 16);
+            let cell = grid.cell_of[slot] as usize;
+            let (row, column) = (cell / columns, cell % columns);
+            let within = grid
+                .cells
+                .position_in_cells(grid.circle_in_slot(slot).center);
+            assert_eq!((within.x as usize, within.y as usize), (column, row));
+            // The extra row lies on the side of the cell where the circle's centre is.
+            let upper = within.y - row as f64 >= 0.5;
+            let extra = if upper { row + 2 } else { row.wrapping_sub(2) };
+            if (2..rows - 2).contains(&row) && (2..columns - 2).contains(&column) {
+                assert_eq!(wide.len(), 16, "slot {slot}");
+                assert!(wide.iter().any(|&c| c / columns == extra), "slot {slot}");
+                reached[usize::from(upper)] += 1;
+            }
+        }
+        assert!(reached[0] > 20 && reached[1] > 20, "{reached:?}");
+        // Loading them, for every slot, big balls' and past the last too, reads nothing amiss.
+        for slot in 0..grid.len() + 3 {
+            grid.load_wide_cell_starts_around(slot);
+            grid.load_wide_cells_around(slot);
+        }
     }
 
     #[test]
@@ -236,6 +360,7 @@ mod tests {
         // Big balls have no cell, and a slot past the last is nothing: both load nothing.
         for slot in grid.small_count()..grid.len() + 3 {
             assert_eq!(grid.cell_runs_around(slot).count(), 0, "slot {slot}");
+            assert_eq!(grid.wide_cell_runs_around(slot).count(), 0, "slot {slot}");
             grid.prefetch_slot(slot);
             grid.prefetch_cell_starts_around(slot);
             grid.prefetch_cells_around(slot);
