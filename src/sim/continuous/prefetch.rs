@@ -31,7 +31,8 @@ impl Timeline {
     /// at a million balls waiting for those reads is most of an impact's cost
     /// (docs/performance.md, *Prefetching the coming impacts*). In three stages, each reading
     /// only what the one before loaded: the balls and their cells; then where the rows of
-    /// cells around the first ball start; then those rows' first circles. For the step's
+    /// cells around the first ball start; then those rows' first circles (every circle of a
+    /// wider region for very many balls: `UniformGrid::prefetch_cells_around`). For the step's
     /// first predictions, a few places ahead, a stage each, once for each of them taken (an
     /// impact predicted since, taken, leaves them where they were); for the earliest impact
     /// predicted since, a stage at each call while it stays the earliest, so that no stage
