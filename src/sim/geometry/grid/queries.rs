@@ -94,7 +94,10 @@ impl UniformGrid {
         }
     }
 
-    /// Whether the loads ahead cover the wider region ([`WIDE_LOADS_MIN_BALLS`]).
+    /// Whether the loads ahead cover the wider region ([`WIDE_LOADS_MIN_BALLS`]). Its loads
+    /// are kept out of line: chosen between in one function with the narrow ones, they kept
+    /// the narrow ones from being inlined into the timeline's loop, 1.4% more instructions at
+    /// 30,000 balls.
     fn loads_wide(&self) -> bool {
         self.len() >= WIDE_LOADS_MIN_BALLS
     }
