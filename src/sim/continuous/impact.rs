@@ -83,17 +83,6 @@ pub struct Party {
     pub hits: u32,
 }
 
-impl Party {
-    /// The ball in `slot`, which has had `hits` hits; `order[slot]` is its index.
-    pub fn new(slot: usize, order: &[u32], hits: u32) -> Self {
-        Self {
-            slot,
-            index: order[slot],
-            hits,
-        }
-    }
-}
-
 impl Impact {
     /// Ball `ball` reaching `wall` at `time`.
     pub fn with_wall(time: f64, ball: Party, wall: Wall) -> Self {

@@ -16,7 +16,7 @@ use std::ops::Range;
 
 use bevy::math::DVec2;
 
-use super::impact::{Impact, Party, Prediction, approach_time, swept_circle, swept_circle_under};
+use super::impact::{Impact, Prediction, approach_time, swept_circle, swept_circle_under};
 use super::prefetch::{INPUTS_AHEAD, prefetch_inputs};
 use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, overlapping, within_reach};
@@ -104,7 +104,7 @@ impl Timeline {
                 place(grid.slots_of_row(row + 1), movers, found);
             }
             grid.for_each_pair_within_reach_in_rows(row..row + 1, |i, j, _, _| {
-                predict_pair((movers, order), (i, j), spec.dt, found);
+                predict_pair(movers, (i, j), spec.dt, found);
             });
         }
     }
@@ -113,10 +113,10 @@ impl Timeline {
     /// swept circles bound the paths: if they do not touch, the balls cannot), by their
     /// distance alone ([`within_reach`]), in parallel bands for many balls.
     fn predict_every_pair(&mut self, dt: f64) {
-        let (movers, order) = (&self.movers, &self.order);
+        let movers = &self.movers;
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
             grid.for_each_pair_within_reach_in_rows(rows, |i, j, _, _| {
-                predict_pair((movers, order), (i, j), dt, found);
+                predict_pair(movers, (i, j), dt, found);
             });
         });
     }
@@ -150,7 +150,7 @@ impl Timeline {
                     {
                         return;
                     }
-                    predict_pair((movers, order), (slot as u32, other as u32), dt, found);
+                    predict_pair(movers, (slot as u32, other as u32), dt, found);
                 });
         }
     }
@@ -169,7 +169,8 @@ fn make_swept_circles(swept: &mut [Circle], inputs: Inputs, spec: StepSpec) {
     let pieces = swept.chunks_mut(BALLS_PER_PIECE).zip(piece_ranges(count));
     in_pieces(pieces, worth_splitting(count), |(swept, balls)| {
         for (swept, ball) in swept.iter_mut().zip(balls) {
-            let mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+            let (circle, velocity) = (circles[ball], velocities[ball]);
+            let mover = Mover::new(ball as u32, circle, velocity, spec.gravity, held[ball]);
             let accel_length = if mover.is_still() {
                 0.0
             } else {
@@ -193,11 +194,12 @@ fn place_movers(
     for (mover, slot) in movers.iter_mut().zip(slots) {
         prefetch_inputs((circles, velocities, held), order, slot + INPUTS_AHEAD);
         let ball = order[slot] as usize;
-        *mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+        let (circle, velocity) = (circles[ball], velocities[ball]);
+        *mover = Mover::new(ball as u32, circle, velocity, spec.gravity, held[ball]);
         if let Some((time, wall)) = wall_time(mover, grid.circle_in_slot(slot), spec)
             && time <= spec.dt
         {
-            let impact = Impact::with_wall(time, Party::new(slot, order, 0), wall);
+            let impact = Impact::with_wall(time, mover.party(slot), wall);
             walls.push(Prediction::Impact(impact));
         }
     }
@@ -280,22 +282,15 @@ pub(super) fn wall_time(
 const FEW_FLYING: usize = 4;
 
 /// What the search finds for the pair of slots `(i, j)`, in either order: an overlap at the
-/// start, an impact within the step, each naming the lower slot first. `order` gives each
-/// slot's index in the step's input.
-fn predict_pair(
-    (movers, order): (&[Mover], &[u32]),
-    (i, j): (u32, u32),
-    dt: f64,
-    found: &mut Vec<Prediction>,
-) {
+/// start, an impact within the step, each naming the lower slot first.
+fn predict_pair(movers: &[Mover], (i, j): (u32, u32), dt: f64, found: &mut Vec<Prediction>) {
     let (a, b) = (i.min(j), i.max(j));
     let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
     if overlapping(mover_a.circle(), mover_b.circle()) {
         found.push(Prediction::Overlap(a, b));
     }
     if let Some(time) = first_pair_time(mover_a, mover_b, dt) {
-        let party = |slot: u32| Party::new(slot as usize, order, 0);
-        let impact = Impact::between(time, party(a), party(b));
+        let impact = Impact::between(time, mover_a.party(a as usize), mover_b.party(b as usize));
         found.push(Prediction::Impact(impact));
     }
 }
@@ -331,7 +326,7 @@ mod tests {
                 rng.random_range(-900.0..900.0),
             );
             let circle = Circle::new(center, rng.random_range(1.0..12.0));
-            let mut mover = Mover::new(circle, velocity, gravity, k.is_multiple_of(5));
+            let mut mover = Mover::new(k as u32, circle, velocity, gravity, k.is_multiple_of(5));
             if k.is_multiple_of(7) {
                 mover.accel = DVec2::ZERO;
             }
@@ -471,7 +466,8 @@ mod tests {
                 rng.random_range(-3000.0..3000.0),
                 rng.random_range(-3000.0..3000.0),
             );
-            let mut mover = Mover::new(Circle::new(center, radius), velocity, spec.gravity, false);
+            let circle = Circle::new(center, radius);
+            let mut mover = Mover::new(case as u32, circle, velocity, spec.gravity, false);
             if case % 7 == 0 {
                 // Sliding along the floor, as after stopping against it.
                 mover.center.y = -limit.y;

@@ -150,9 +150,12 @@ mod tests {
 
     #[test]
     fn the_loads_ahead_follow_what_is_taken_and_the_earliest_later_one_by_stages() {
-        let order = [0, 1, 2, 3, 4, 5];
-        let impact =
-            |time, a, b| Impact::between(time, Party::new(a, &order, 0), Party::new(b, &order, 0));
+        let party = |slot: usize| Party {
+            slot,
+            index: slot as u32,
+            hits: 0,
+        };
+        let impact = |time, a, b| Impact::between(time, party(a), party(b));
         let mut timeline = Timeline::default();
         let first = [impact(0.002, 0, 1), impact(0.014, 4, 5)];
         timeline.queue.start(first.into_iter(), 1.0 / 60.0);

@@ -3,7 +3,7 @@
 //! two balls of a collision touch, so their neighbourhoods are mostly the same: one search of
 //! the cells around both finds both balls' impacts ([`Timeline::predict_for_both`]).
 
-use super::impact::{Impact, Party};
+use super::impact::Impact;
 use super::predict::{SWEPT_MARGIN, pair_time, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
@@ -22,11 +22,11 @@ impl Timeline {
         }
         let swept = new_swept(&self.movers[slot], now, spec);
         self.take_new_path(slot, swept, now, spec);
-        let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
+        let (movers, queue) = (&self.movers, &mut self.queue);
         let hits_of = |other: u32| movers[other as usize].hits;
         self.paths
             .for_each_that_may_touch(&self.grid, swept, hits_of, |other| {
-                queue_pair_impact((movers, order), (slot, other as usize), now, spec.dt, queue);
+                queue_pair_impact(movers, (slot, other as usize), now, spec.dt, queue);
             });
     }
 
@@ -56,9 +56,9 @@ impl Timeline {
         let a_finds_b =
             b < self.grid.small_count() && within_reach(swept[0], self.grid.circle_in_slot(b));
         self.take_new_path(b, swept[1], now, spec);
-        let (movers, queue, order) = (&self.movers, &mut self.queue, &self.order);
+        let (movers, queue) = (&self.movers, &mut self.queue);
         let hits_of = |other: u32| movers[other as usize].hits;
-        let (end, balls) = (spec.dt, (movers.as_slice(), order.as_slice()));
+        let (end, balls) = (spec.dt, movers.as_slice());
         let found = &mut self.found;
         found.clear();
         // The two balls find themselves and each other: only `b` finding `a` is timed (as the
@@ -93,7 +93,7 @@ impl Timeline {
         if let Some((time, wall)) = wall_time(&mover, swept, spec)
             && now + time <= spec.dt
         {
-            let party = Party::new(slot, &self.order, mover.hits);
+            let party = mover.party(slot);
             self.queue.push(Impact::with_wall(now + time, party, wall));
         }
         self.paths
@@ -112,7 +112,7 @@ fn new_swept(mover: &Mover, now: f64, spec: StepSpec) -> Circle {
 /// Queues the impact of the balls in `slot` and `other`, redirected at `now`, if their paths
 /// meet by `end` (none for a ball with itself).
 fn queue_pair_impact(
-    (movers, order): (&[Mover], &[u32]),
+    movers: &[Mover],
     (slot, other): (usize, usize),
     now: f64,
     end: f64,
@@ -125,11 +125,10 @@ fn queue_pair_impact(
     let Some(time) = pair_time(mover, other_mover, now, end) else {
         return;
     };
-    let party = |slot: usize, mover: &Mover| Party::new(slot, order, mover.hits);
     queue.push(Impact::between(
         time,
-        party(slot, mover),
-        party(other, other_mover),
+        mover.party(slot),
+        other_mover.party(other),
     ));
 }
 

@@ -7,7 +7,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::impact::{Impact, Prediction};
+use super::impact::{Impact, Party, Prediction};
 use super::paths::Paths;
 use super::queue::ImpactQueue;
 use crate::sim::geometry::Circle;
@@ -15,7 +15,7 @@ use crate::sim::geometry::circle::RadiusRange;
 use crate::sim::geometry::flight::{position_after, velocity_after};
 use crate::sim::geometry::grid::UniformGrid;
 use crate::sim::geometry::pairs::{FoundInBands, IndexedContact};
-use crate::sim::params::{MassModel, SimParams};
+use crate::sim::params::{MAX_BALLS, MassModel, SimParams};
 use crate::sim::resting::rest_speed;
 
 /// The fewest hits a ball may take in one step ([`hit_limit`]).
@@ -103,7 +103,7 @@ impl StepSpec {
 ///
 /// Its fields lie in the order written (`repr(C)`, 72 B): the timeline's prefetching loads
 /// its first and its last lines by `center` and `hits`. They are plain numbers
-/// (`bytemuck::Pod`: whether it is still is a byte, not a `bool`), so that the timeline's
+/// (`bytemuck::Pod`: whether it is still is a bit, not a `bool`), so that the timeline's
 /// buffer of movers can hold the step's swept circles while the grid is built
 /// ([`Timeline::predict`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -116,13 +116,21 @@ pub(super) struct Mover {
     pub radius: f64,
     pub clock: f64,
     pub hits: u32,
-    /// 1 while it holds still, else 0 ([`is_still`](Self::is_still)).
-    still: u8,
-    _padding: [u8; 3],
+    /// Its ball's index in the step's input ([`party`](Self::party)), and [`STILL`] while it
+    /// holds still ([`is_still`](Self::is_still)). The impacts name a ball by that index too,
+    /// and read it here, beside the hits, rather than from `Timeline::order`: at a million
+    /// balls a read of `order` at a random slot goes to memory.
+    index_and_still: u32,
 }
 
+/// The bit of `Mover::index_and_still` that says the ball holds still: an index is below
+/// [`MAX_BALLS`], far below it.
+const STILL: u32 = 1 << 31;
+const _: () = assert!(MAX_BALLS <= STILL as usize);
+
 impl Mover {
-    pub fn new(circle: Circle, velocity: DVec2, gravity: DVec2, still: bool) -> Self {
+    /// The ball of index `index` in the step's input, at the start of the step.
+    pub fn new(index: u32, circle: Circle, velocity: DVec2, gravity: DVec2, still: bool) -> Self {
         Self {
             center: circle.center,
             velocity,
@@ -130,20 +138,29 @@ impl Mover {
             radius: circle.radius,
             clock: 0.0,
             hits: 0,
-            still: u8::from(still),
-            _padding: [0; 3],
+            index_and_still: index | if still { STILL } else { 0 },
+        }
+    }
+
+    /// The ball, in `slot`, as an impact predicted now names it.
+    #[inline]
+    pub fn party(&self, slot: usize) -> Party {
+        Party {
+            slot,
+            index: self.index_and_still & !STILL,
+            hits: self.hits,
         }
     }
 
     /// Whether it holds still (see the type's header).
     #[inline]
     pub fn is_still(&self) -> bool {
-        self.still != 0
+        self.index_and_still & STILL != 0
     }
 
     /// Holds still from now on, with its acceleration gone.
     pub fn hold_still(&mut self) {
-        self.still = 1;
+        self.index_and_still |= STILL;
         self.accel = DVec2::ZERO;
     }
 
@@ -199,7 +216,7 @@ impl Mover {
     pub fn fly(&mut self, velocity: DVec2, gravity: DVec2) {
         self.velocity = velocity;
         self.accel = gravity;
-        self.still = 0;
+        self.index_and_still &= !STILL;
     }
 }
 
@@ -283,6 +300,24 @@ mod tests {
     use crate::sim::continuous::predict::swept_by;
 
     #[test]
+    fn a_mover_names_its_ball_by_its_index_whether_it_holds_still_or_flies() {
+        let circle = Circle::new(DVec2::ZERO, 1.0);
+        let last = MAX_BALLS as u32 - 1;
+        for (index, still) in [(0, false), (7, true), (last, true), (last, false)] {
+            let mut mover = Mover::new(index, circle, DVec2::X, DVec2::NEG_Y, still);
+            assert_eq!(mover.is_still(), still, "{index}");
+            mover.hold_still();
+            assert!(mover.is_still() && mover.accel == DVec2::ZERO);
+            assert_eq!(mover.party(3).index, index);
+            mover.fly(DVec2::Y, DVec2::NEG_Y);
+            mover.hits = 5;
+            assert!(!mover.is_still());
+            let party = mover.party(3);
+            assert_eq!((party.slot, party.index, party.hits), (3, index, 5));
+        }
+    }
+
+    #[test]
     fn the_grid_holds_each_swept_circle_and_every_mover_is_made_again_after_the_loan() {
         // The movers' buffer holds the swept circles while the grid is built: afterwards the
         // grid must hold each ball's swept circle and every slot its own mover, as the count
@@ -308,7 +343,13 @@ mod tests {
             assert_eq!(timeline.movers.len(), count);
             for slot in 0..count {
                 let ball = timeline.order[slot] as usize;
-                let mover = Mover::new(circles[ball], velocities[ball], spec.gravity, held[ball]);
+                let mover = Mover::new(
+                    ball as u32,
+                    circles[ball],
+                    velocities[ball],
+                    spec.gravity,
+                    held[ball],
+                );
                 let swept = swept_by(&mover, spec.dt);
                 assert_eq!(timeline.grid.circle_in_slot(slot), swept, "slot {slot}");
                 assert_eq!(timeline.movers[slot], mover, "slot {slot}");
