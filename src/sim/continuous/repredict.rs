@@ -43,7 +43,7 @@ impl Timeline {
     /// as it is found ([`prefetch_mover`]), and timed after: their loads overlap (at a
     /// million balls the movers lie well past the cache: −3% there, −1% at 100,000). The
     /// search comes before the two balls take their new paths, and the timing after, so that
-    /// those loads have that long too to arrive (−1 to −2% at both sizes).
+    /// those loads have that long too to arrive (about −2% at both sizes).
     pub(super) fn predict_for_both(&mut self, (a, b): (usize, usize), now: f64, spec: StepSpec) {
         let spent = |slot: usize| self.movers[slot].hits == spec.hit_limit;
         if spent(a) || spent(b) {

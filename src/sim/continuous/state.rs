@@ -123,8 +123,8 @@ pub(super) struct Mover {
     index_and_still: u32,
 }
 
-/// The bit of `Mover::index_and_still` that says the ball holds still: an index is below
-/// [`MAX_BALLS`], far below it.
+/// The bit of `Mover::index_and_still` that says the ball holds still: the top one, far above
+/// any index (each below [`MAX_BALLS`]).
 const STILL: u32 = 1 << 31;
 const _: () = assert!(MAX_BALLS <= STILL as usize);
 
