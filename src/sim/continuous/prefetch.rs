@@ -93,8 +93,8 @@ impl Timeline {
 
 /// How many slots ahead of the ball it is placing the pass that puts the balls on the
 /// timeline (`predict.rs`, `place_movers`) loads a ball's inputs ([`prefetch_inputs`]). At a
-/// million balls a ball takes that pass about 8 ns and a read from memory over 100: 16 ahead
-/// was 1–1.5% slower there, and the same at 100,000 (64 ahead did about as well as 32).
+/// million balls a ball takes that pass about 8 ns, far less than a read from memory: 16
+/// ahead was 0.4–1.5% slower there, and the same at 100,000 (64 ahead no better than 32).
 pub(super) const INPUTS_AHEAD: usize = 32;
 
 /// Loads what the collision stage was given for the ball in `slot` (its circle, velocity and
