@@ -99,7 +99,7 @@ impl CellMap {
         // through `u32` rather than straight to `usize`, whose conversion takes more
         // instructions (−2% a continuous step), for the same cells: no grid has more than
         // `u32::MAX` along an axis (`covering`).
-        let cell = (point - self.origin) * self.inverse_cell_size;
+        let cell = self.position_in_cells(point);
         let column = (cell.x as u32 as usize).min(self.columns - 1);
         let row = (cell.y as u32 as usize).min(self.rows - 1);
         (column, row)
