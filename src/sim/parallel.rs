@@ -134,9 +134,9 @@ const SPIN_AT_THE_JOIN: std::time::Duration = std::time::Duration::from_micros(4
 /// consecutive pieces, and takes its own one after another before it helps with what is left
 /// of the others'. So each thread works, pass after pass, on much the same part of the
 /// arrays, and the threads meet at a count only at the end of a pass. Taken from one count
-/// shared by every piece, as before, two threads at 100,000 balls were 4% slower in the
+/// shared by every piece, as before, two threads at 100,000 balls were 5% slower in the
 /// discrete mode and 1% in the continuous one, and 32% and 8% slower while the host kept the
-/// two cores far apart (a cache line's round trip between them 390–440 ns, against 75–110 ns
+/// two cores far apart (a cache line's round trip between them 387–438 ns, against 74–166 ns
 /// otherwise: docs/performance.md, *Each thread its own share of a pass*).
 struct SharedPieces<P, R> {
     pieces: Vec<Mutex<Option<P>>>,
