@@ -131,7 +131,7 @@ fn place(
 /// slots `starts[c]..starts[c + 1]`). Most cells hold 0 to 3 balls, at random, so a branch on
 /// each cell's count would often be mispredicted: each cell, in order, writes its number into
 /// the [`RUN_WRITTEN`] slots from its first, and the cells after it overwrite what lies past
-/// its own. Only a cell of more balls, rare, writes just its own, one by one. (Before, each
+/// its own. Only a cell of more balls, rare, writes just its own slots. (Before, each
 /// cell wrote its number at its first slot and each slot then took the highest number
 /// written up to it: a chain of dependent steps, 2.6% of the continuous step at 100,000
 /// balls, now 0.45%.)
@@ -150,8 +150,7 @@ pub fn cells_of_slots(starts: &[u32], cells: Range<usize>, slots: &mut [u32]) {
     }
 }
 
-/// How many slots [`cells_of_slots`] writes for each cell: a cell holds fewer balls but
-/// rarely.
+/// How many slots [`cells_of_slots`] writes for each cell: a cell rarely holds more balls.
 const RUN_WRITTEN: usize = 4;
 
 #[cfg(test)]
