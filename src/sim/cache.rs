@@ -1,13 +1,27 @@
 //! Loads ahead: [`prefetch`] asks the processor to bring a place into the cache and goes on
 //! at once. The continuous timeline uses it for what the impacts about to be taken will read
 //! (`continuous/prefetch.rs`, the grid's `prefetch_slot`), the discrete response for the
-//! balls of the contacts to come (`geometry/impulse.rs`); nothing here changes a result.
+//! balls of the contacts to come (`geometry/impulse.rs`), the grid's counting sort and gather
+//! for a great many balls (`geometry/grid/`); nothing here changes a result.
 
 /// Below this many balls the arrays a step reads mostly fit the cache, and loading ahead only
 /// costs: measured for both users, 1–3% at 1,000 and 10,000 balls (four rounds each), where
 /// from 30,000 on the continuous timeline gains (docs/performance.md, *Prefetching the coming
 /// impacts*).
 pub const PREFETCH_MIN_BALLS: usize = 20_000;
+
+/// From this many balls the grid's per-ball arrays outgrow this host's 32 MB last-level cache,
+/// and its passes that reach into them by index load [`BALLS_AHEAD`] balls ahead. The balls are
+/// stored in space order (`scene/build.rs`), so those passes mostly walk forward; but each ball
+/// that changed rows of cells since it was stored is a jump the processor's own stream
+/// detection does not foresee. Discrete mode, one thread, means of three or four rounds in
+/// turn (docs/performance.md, *The grid's passes by index loaded ahead*): 1,000,000 balls
+/// −5%, 200,000 −2%, and 100,000 +3.5%, where the arrays still fit the cache.
+pub const FAR_PREFETCH_MIN_BALLS: usize = 200_000;
+
+/// How many balls ahead a pass by index loads, from [`FAR_PREFETCH_MIN_BALLS`] balls: at a
+/// million, 96 to 256 measured alike, 8 and 32 less.
+pub const BALLS_AHEAD: usize = 128;
 
 /// Starts bringing the cache line that holds `place` into every level of the cache, without
 /// waiting for it: unlike a load, the instruction is done at once, so the misses of several

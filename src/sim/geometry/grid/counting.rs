@@ -6,6 +6,7 @@
 
 use std::ops::Range;
 
+use crate::sim::cache::{BALLS_AHEAD, FAR_PREFETCH_MIN_BALLS, prefetch};
 use crate::sim::parallel::{carve, in_pieces, split_evenly, threads_at_work};
 
 /// Marks a big ball, which has no cell.
@@ -49,13 +50,14 @@ pub fn sort_into_cells(
     let bands = bands.clamp(1, cell_count.max(1));
     let band_cells = split_evenly(cell_count, bands);
     let parallel = bands > 1;
+    let loading_ahead = cell_of.len() >= FAR_PREFETCH_MIN_BALLS;
     // Each band counts its cells' balls: `cell_start` then holds each cell's end within the band.
     let totals = in_pieces(
         band_cells
             .clone()
             .zip(carve(&mut cell_start[..cell_count], band_cells.clone())),
         parallel,
-        |(cells, ends)| count_ends(cell_of, cells, ends),
+        |(cells, ends)| count_ends(cell_of, cells, ends, loading_ahead),
     );
     let small_count: u32 = totals.iter().sum();
     let mut band_first = 0;
@@ -74,7 +76,12 @@ pub fn sort_into_cells(
         .zip(carve(sorted_index, band_slots.iter().cloned()))
         .zip(&band_slots);
     in_pieces(bands_work, parallel, |(((cells, ends), slots), range)| {
-        place(cell_of, (cells, ends), slots, range.start as u32);
+        place(
+            cell_of,
+            (cells, ends),
+            slots,
+            (range.start as u32, loading_ahead),
+        );
     });
     cell_start[cell_count] = small_count;
     let big_balls = (0..cell_of.len() as u32).filter(|&index| cell_of[index as usize] == NO_CELL);
@@ -88,11 +95,15 @@ pub fn sort_into_cells(
 }
 
 /// `ends[c - cells.start]` set to how many balls in `cell_of` are in cells `cells.start..=c`;
-/// returns how many are in `cells`.
-fn count_ends(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32]) -> u32 {
+/// returns how many are in `cells`. With `loading_ahead`, the count of the cell of the ball
+/// [`BALLS_AHEAD`] on is loaded as each is counted ([`FAR_PREFETCH_MIN_BALLS`]).
+fn count_ends(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32], loading_ahead: bool) -> u32 {
     ends.fill(0);
     let (first, last) = (cells.start as u32, cells.end as u32);
-    for &cell in cell_of {
+    for (index, &cell) in cell_of.iter().enumerate() {
+        if loading_ahead {
+            load_cell_ahead(cell_of.get(index + BALLS_AHEAD), first, ends);
+        }
         if (first..last).contains(&cell) {
             ends[(cell - first) as usize] += 1;
         }
@@ -107,15 +118,20 @@ fn count_ends(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32]) -> u32 {
 
 /// Places the balls of `cells` in `slots` (which start at slot `first_slot`), going through
 /// the balls in reverse so each cell keeps its balls in input order; `ends`, each cell's end
-/// within the band, become each cell's start slot.
+/// within the band, become each cell's start slot. With `loading_ahead`, as
+/// [`count_ends`].
 fn place(
     cell_of: &[u32],
     (cells, ends): (Range<usize>, &mut [u32]),
     slots: &mut [u32],
-    first_slot: u32,
+    (first_slot, loading_ahead): (u32, bool),
 ) {
     let (first, last) = (cells.start as u32, cells.end as u32);
     for (index, &cell) in cell_of.iter().enumerate().rev() {
+        if loading_ahead {
+            let coming = index.checked_sub(BALLS_AHEAD);
+            load_cell_ahead(coming.and_then(|coming| cell_of.get(coming)), first, ends);
+        }
         if (first..last).contains(&cell) {
             let end = &mut ends[(cell - first) as usize];
             *end -= 1;
@@ -124,6 +140,14 @@ fn place(
     }
     for end in ends.iter_mut() {
         *end += first_slot;
+    }
+}
+
+/// Loads the entry of `ends` (the band's cells from `first` on) for the cell `coming`, if the
+/// ball is coming and its cell is the band's.
+fn load_cell_ahead(coming: Option<&u32>, first: u32, ends: &[u32]) {
+    if let Some(&cell) = coming {
+        prefetch(ends.get(cell.wrapping_sub(first) as usize));
     }
 }
 
@@ -193,24 +217,38 @@ mod tests {
     #[test]
     fn any_number_of_bands_sorts_stably_with_the_big_balls_last() {
         // 3,000 balls in 97 cells, every seventh big.
-        let cell_of: Vec<u32> = (0..3000u32)
-            .map(|k| if k % 7 == 3 { NO_CELL } else { k * 31 % 97 })
+        sorts_stably_in_bands(3000, 97, &[2, 3, 8, 500]);
+    }
+
+    #[test]
+    fn so_many_balls_that_the_sort_loads_ahead_sort_alike() {
+        // Enough balls for the loads ahead, in more cells than a load ahead's reach.
+        let count = FAR_PREFETCH_MIN_BALLS as u32 + 3000;
+        sorts_stably_in_bands(count, 50_021, &[2, 3]);
+    }
+
+    /// Sorts `count` balls into `cells` cells, every seventh big, the others spread over the
+    /// cells, and checks the sort in one band, then that each of `more_bands` sorts alike.
+    fn sorts_stably_in_bands(count: u32, cells: u32, more_bands: &[usize]) {
+        let cell_of: Vec<u32> = (0..count)
+            .map(|k| if k % 7 == 3 { NO_CELL } else { k * 31 % cells })
             .collect();
         let sort = |bands: usize| {
             let (mut starts, mut slots) = (Vec::new(), Vec::new());
-            let small = sort_into_cells(&cell_of, 97, (&mut starts, &mut slots), bands);
+            let small = sort_into_cells(&cell_of, cells as usize, (&mut starts, &mut slots), bands);
             (small, starts, slots)
         };
         let (small, starts, slots) = sort(1);
-        assert_eq!(small, 3000 - 3000 / 7 - 1);
-        for cell in 0..97 {
+        let big = (0..count).filter(|k| k % 7 == 3).count();
+        assert_eq!(small, count as usize - big);
+        for cell in 0..cells as usize {
             let balls = &slots[starts[cell] as usize..starts[cell + 1] as usize];
             assert!(balls.iter().all(|&k| cell_of[k as usize] == cell as u32));
             assert!(balls.windows(2).all(|pair| pair[0] < pair[1]), "stable");
         }
         assert!(slots[small..].iter().all(|&k| k % 7 == 3));
         assert!(slots[small..].windows(2).all(|pair| pair[0] < pair[1]));
-        for bands in [2, 3, 8, 500] {
+        for &bands in more_bands {
             assert_eq!(
                 sort(bands),
                 (small, starts.clone(), slots.clone()),

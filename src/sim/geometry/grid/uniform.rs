@@ -13,6 +13,7 @@ use super::cells::CellMap;
 use super::counting::{NO_CELL, cells_of_slots, sort_bands, sort_into_cells};
 use super::extent::Extent;
 use super::rows::RowLists;
+use crate::sim::cache::{BALLS_AHEAD, FAR_PREFETCH_MIN_BALLS, prefetch};
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
     BALLS_PER_PIECE, carve, in_pieces, piece_ranges, split_evenly, threads_at_work, worth_splitting,
@@ -52,6 +53,18 @@ pub struct UniformGrid {
     pub(super) big_rows: RowLists,
 }
 
+/// Each slot's circle from `circles`, the ball `indices` gives for it; with `loading_ahead`, the
+/// circle [`BALLS_AHEAD`] slots on is loaded as each is copied ([`FAR_PREFETCH_MIN_BALLS`]).
+fn gather(slots: &mut [Circle], indices: &[u32], circles: &[Circle], loading_ahead: bool) {
+    for (at, (slot, &index)) in slots.iter_mut().zip(indices).enumerate() {
+        if loading_ahead {
+            let later = indices.get(at + BALLS_AHEAD);
+            prefetch(later.and_then(|&later| circles.get(later as usize)));
+        }
+        *slot = circles[index as usize];
+    }
+}
+
 /// Whether a ball of `radius` is big where the limit is `big_limit`. A NaN is not big.
 fn is_big(radius: f64, big_limit: f64) -> bool {
     radius > big_limit
@@ -60,18 +73,13 @@ fn is_big(radius: f64, big_limit: f64) -> bool {
 impl UniformGrid {
     /// Sorts `circles` into cells, the big ones apart.
     pub fn rebuild(&mut self, circles: &[Circle]) {
-        self.rebuild_with(circles.len(), |index| circles[index]);
-    }
-
-    /// [`rebuild`](Self::rebuild) with the `count` circles given by `circle_at(index)`, each
-    /// asked for a few times (its extent, its cell, its place in slot order).
-    fn rebuild_with(&mut self, count: usize, circle_at: impl Fn(usize) -> Circle + Sync) {
+        let (count, circle_at) = (circles.len(), |index: usize| circles[index]);
         // The extent, the radii's sum and the largest radius in one pass, in pieces (on the
         // compute pool for many balls): the pieces' sums are added in their order, and a
         // piece's size is fixed, so the mean's rounding never depends on the threads.
         let parallel = worth_splitting(count);
         let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
-            Extent::of(balls, &circle_at)
+            Extent::of(balls, circle_at)
         });
         let all = by_piece.into_iter().fold(Extent::NONE, Extent::joined);
         let (mut min, mut max, radius_sum) = (all.min, all.max, all.radius_sum);
@@ -126,10 +134,9 @@ impl UniformGrid {
             .sorted_circle
             .chunks_mut(BALLS_PER_PIECE)
             .zip(self.sorted_index.chunks(BALLS_PER_PIECE));
-        in_pieces(slot_pieces, parallel, |(circles, indices)| {
-            for (circle, &index) in circles.iter_mut().zip(indices) {
-                *circle = circle_at(index as usize);
-            }
+        let loading_ahead = count >= FAR_PREFETCH_MIN_BALLS;
+        in_pieces(slot_pieces, parallel, |(slots, indices)| {
+            gather(slots, indices, circles, loading_ahead);
         });
         self.rebuild_big();
     }
@@ -306,6 +313,34 @@ mod tests {
                 assert!(seen.contains(&(i, j)), "grid missed pair ({i}, {j})");
             }
         });
+    }
+
+    #[test]
+    fn so_many_balls_that_the_gather_loads_ahead_each_slot_holds_its_ball() {
+        // A lattice 500 balls wide, stored in an order that jumps about rows apart.
+        let count = FAR_PREFETCH_MIN_BALLS + 1000;
+        let circles: Vec<Circle> = (0..count)
+            .map(|k| (k * 7919) % count)
+            .map(|k| Circle::new(DVec2::new((k % 500) as f64, (k / 500) as f64) * 3.0, 1.0))
+            .collect();
+        let mut grid = UniformGrid::default();
+        grid.rebuild(&circles);
+        let mut seen = vec![false; count];
+        let cells: Vec<usize> = (0..count)
+            .map(|slot| {
+                let index = grid.sorted_index[slot] as usize;
+                assert_eq!(grid.sorted_circle[slot], circles[index], "slot {slot}");
+                assert!(
+                    !std::mem::replace(&mut seen[index], true),
+                    "ball {index} twice"
+                );
+                grid.cells.cell_index(circles[index].center)
+            })
+            .collect();
+        assert!(
+            cells.windows(2).all(|pair| pair[0] <= pair[1]),
+            "in cell order"
+        );
     }
 
     #[test]
