@@ -57,7 +57,13 @@ pub fn sort_into_cells(
             .clone()
             .zip(carve(&mut cell_start[..cell_count], band_cells.clone())),
         parallel,
-        |(cells, ends)| count_ends(cell_of, cells, ends, loading_ahead),
+        |(cells, ends)| {
+            if loading_ahead {
+                count_ends::<BALLS_AHEAD>(cell_of, cells, ends)
+            } else {
+                count_ends::<0>(cell_of, cells, ends)
+            }
+        },
     );
     let small_count: u32 = totals.iter().sum();
     let mut band_first = 0;
@@ -76,12 +82,12 @@ pub fn sort_into_cells(
         .zip(carve(sorted_index, band_slots.iter().cloned()))
         .zip(&band_slots);
     in_pieces(bands_work, parallel, |(((cells, ends), slots), range)| {
-        place(
-            cell_of,
-            (cells, ends),
-            slots,
-            (range.start as u32, loading_ahead),
-        );
+        let (band, first_slot) = ((cells, ends), range.start as u32);
+        if loading_ahead {
+            place::<BALLS_AHEAD>(cell_of, band, slots, first_slot)
+        } else {
+            place::<0>(cell_of, band, slots, first_slot)
+        }
     });
     cell_start[cell_count] = small_count;
     let big_balls = (0..cell_of.len() as u32).filter(|&index| cell_of[index as usize] == NO_CELL);
@@ -95,14 +101,14 @@ pub fn sort_into_cells(
 }
 
 /// `ends[c - cells.start]` set to how many balls in `cell_of` are in cells `cells.start..=c`;
-/// returns how many are in `cells`. With `loading_ahead`, the count of the cell of the ball
-/// [`BALLS_AHEAD`] on is loaded as each is counted ([`FAR_PREFETCH_MIN_BALLS`]).
-fn count_ends(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32], loading_ahead: bool) -> u32 {
+/// returns how many are in `cells`. With `AHEAD` above 0, the count of the cell of the ball
+/// `AHEAD` on is loaded as each is counted ([`FAR_PREFETCH_MIN_BALLS`]).
+fn count_ends<const AHEAD: usize>(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32]) -> u32 {
     ends.fill(0);
     let (first, last) = (cells.start as u32, cells.end as u32);
     for (index, &cell) in cell_of.iter().enumerate() {
-        if loading_ahead {
-            load_cell_ahead(cell_of.get(index + BALLS_AHEAD), first, ends);
+        if AHEAD > 0 {
+            load_cell_ahead(cell_of.get(index + AHEAD), first, ends);
         }
         if (first..last).contains(&cell) {
             ends[(cell - first) as usize] += 1;
@@ -118,18 +124,17 @@ fn count_ends(cell_of: &[u32], cells: Range<usize>, ends: &mut [u32], loading_ah
 
 /// Places the balls of `cells` in `slots` (which start at slot `first_slot`), going through
 /// the balls in reverse so each cell keeps its balls in input order; `ends`, each cell's end
-/// within the band, become each cell's start slot. With `loading_ahead`, as
-/// [`count_ends`].
-fn place(
+/// within the band, become each cell's start slot. `AHEAD` as in [`count_ends`].
+fn place<const AHEAD: usize>(
     cell_of: &[u32],
     (cells, ends): (Range<usize>, &mut [u32]),
     slots: &mut [u32],
-    (first_slot, loading_ahead): (u32, bool),
+    first_slot: u32,
 ) {
     let (first, last) = (cells.start as u32, cells.end as u32);
     for (index, &cell) in cell_of.iter().enumerate().rev() {
-        if loading_ahead {
-            let coming = index.checked_sub(BALLS_AHEAD);
+        if AHEAD > 0 {
+            let coming = index.checked_sub(AHEAD);
             load_cell_ahead(coming.and_then(|coming| cell_of.get(coming)), first, ends);
         }
         if (first..last).contains(&cell) {

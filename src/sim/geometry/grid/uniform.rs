@@ -53,12 +53,12 @@ pub struct UniformGrid {
     pub(super) big_rows: RowLists,
 }
 
-/// Each slot's circle from `circles`, the ball `indices` gives for it; with `loading_ahead`, the
-/// circle [`BALLS_AHEAD`] slots on is loaded as each is copied ([`FAR_PREFETCH_MIN_BALLS`]).
-fn gather(slots: &mut [Circle], indices: &[u32], circles: &[Circle], loading_ahead: bool) {
+/// Each slot's circle from `circles`, the ball `indices` gives for it; with `AHEAD` above 0,
+/// the circle `AHEAD` slots on is loaded as each is copied ([`FAR_PREFETCH_MIN_BALLS`]).
+fn gather<const AHEAD: usize>(slots: &mut [Circle], indices: &[u32], circles: &[Circle]) {
     for (at, (slot, &index)) in slots.iter_mut().zip(indices).enumerate() {
-        if loading_ahead {
-            let later = indices.get(at + BALLS_AHEAD);
+        if AHEAD > 0 {
+            let later = indices.get(at + AHEAD);
             prefetch(later.and_then(|&later| circles.get(later as usize)));
         }
         *slot = circles[index as usize];
@@ -136,7 +136,11 @@ impl UniformGrid {
             .zip(self.sorted_index.chunks(BALLS_PER_PIECE));
         let loading_ahead = count >= FAR_PREFETCH_MIN_BALLS;
         in_pieces(slot_pieces, parallel, |(slots, indices)| {
-            gather(slots, indices, circles, loading_ahead);
+            if loading_ahead {
+                gather::<BALLS_AHEAD>(slots, indices, circles)
+            } else {
+                gather::<0>(slots, indices, circles)
+            }
         });
         self.rebuild_big();
     }
