@@ -14,13 +14,14 @@ pub const PREFETCH_MIN_BALLS: usize = 20_000;
 /// and its passes that reach into them by index load [`BALLS_AHEAD`] balls ahead. The balls are
 /// stored in space order (`scene/build.rs`), so those passes mostly walk forward; but each ball
 /// that changed rows of cells since it was stored is a jump the processor's own stream
-/// detection does not foresee. Discrete mode, one thread, means of three or four rounds in
-/// turn (docs/performance.md, *The grid's passes by index loaded ahead*): 1,000,000 balls
-/// −5%, 200,000 −2%, and 100,000 +3.5%, where the arrays still fit the cache.
+/// detection does not foresee. Discrete mode, one thread, rounds in turn: a million balls 1–5%
+/// quicker in every round, 200,000 and 300,000 about 2%; 100,000, where the arrays still fit
+/// the cache, 3.5% slower when loading ahead too (docs/performance.md, *The grid's passes by
+/// index loaded ahead (thirty-fifth session)*).
 pub const FAR_PREFETCH_MIN_BALLS: usize = 200_000;
 
 /// How many balls ahead a pass by index loads, from [`FAR_PREFETCH_MIN_BALLS`] balls: at a
-/// million, 96 to 256 measured alike, 8 and 32 less.
+/// million, 64 to 256 measured alike; 32 gained less and 8 was slower than not loading.
 pub const BALLS_AHEAD: usize = 128;
 
 /// Starts bringing the cache line that holds `place` into every level of the cache, without
