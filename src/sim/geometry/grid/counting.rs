@@ -227,7 +227,7 @@ mod tests {
 
     #[test]
     fn so_many_balls_that_the_sort_loads_ahead_sort_alike() {
-        // Enough balls for the loads ahead, in more cells than a load ahead's reach.
+        // Enough balls for the loads ahead, in 50,021 cells: the counts they load lie far apart.
         let count = FAR_PREFETCH_MIN_BALLS as u32 + 3000;
         sorts_stably_in_bands(count, 50_021, &[2, 3]);
     }

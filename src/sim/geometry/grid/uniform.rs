@@ -321,7 +321,7 @@ mod tests {
 
     #[test]
     fn so_many_balls_that_the_gather_loads_ahead_each_slot_holds_its_ball() {
-        // A lattice 500 balls wide, stored in an order that jumps about rows apart.
+        // A lattice 500 balls wide, each ball stored some 16 rows from the one before.
         let count = FAR_PREFETCH_MIN_BALLS + 1000;
         let circles: Vec<Circle> = (0..count)
             .map(|k| (k * 7919) % count)
