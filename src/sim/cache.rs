@@ -17,7 +17,8 @@ pub const PREFETCH_MIN_BALLS: usize = 20_000;
 /// detection does not foresee. Discrete mode, one thread, rounds in turn: a million balls 1–5%
 /// quicker in every round, 200,000 and 300,000 about 2%; 100,000, where the arrays still fit
 /// the cache, 3.5% slower when loading ahead too (docs/performance.md, *The grid's passes by
-/// index loaded ahead (thirty-fifth session)*).
+/// index loaded ahead (thirty-fifth session)*). From this many balls too, the discrete
+/// response's loads ahead take both lines of a circle that straddles two ([`prefetch_whole`]).
 pub const FAR_PREFETCH_MIN_BALLS: usize = 200_000;
 
 /// How many balls ahead a pass by index loads, from [`FAR_PREFETCH_MIN_BALLS`] balls: at a
@@ -37,4 +38,13 @@ pub fn prefetch<T: Copy>(place: Option<&T>) {
     safe_arch::prefetch_t0(place);
     #[cfg(not(target_arch = "x86_64"))]
     std::hint::black_box(*place);
+}
+
+/// [`prefetch`] for a value that may straddle two cache lines (a 24-byte circle in an array
+/// starts at every multiple of 8 within a line, and a quarter of them end in the next): loads
+/// the lines of its first and last bytes.
+#[inline(always)]
+pub fn prefetch_whole<T: bytemuck::Pod>(place: Option<&T>) {
+    prefetch(place);
+    prefetch(place.and_then(|place| bytemuck::bytes_of(place).last()));
 }

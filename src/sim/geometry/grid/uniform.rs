@@ -13,7 +13,7 @@ use super::cells::CellMap;
 use super::counting::{NO_CELL, cells_of_slots, sort_bands, sort_into_cells};
 use super::extent::Extent;
 use super::rows::RowLists;
-use crate::sim::cache::{BALLS_AHEAD, FAR_PREFETCH_MIN_BALLS, prefetch};
+use crate::sim::cache::{BALLS_AHEAD, FAR_PREFETCH_MIN_BALLS, prefetch_whole};
 use crate::sim::geometry::circle::Circle;
 use crate::sim::parallel::{
     BALLS_PER_PIECE, carve, in_pieces, piece_ranges, split_evenly, threads_at_work, worth_splitting,
@@ -54,12 +54,13 @@ pub struct UniformGrid {
 }
 
 /// Each slot's circle from `circles`, the ball `indices` gives for it; with `AHEAD` above 0,
-/// the circle `AHEAD` slots on is loaded as each is copied ([`FAR_PREFETCH_MIN_BALLS`]).
+/// the circle `AHEAD` slots on is loaded as each is copied, both its cache lines when it
+/// straddles two ([`FAR_PREFETCH_MIN_BALLS`]).
 fn gather<const AHEAD: usize>(slots: &mut [Circle], indices: &[u32], circles: &[Circle]) {
     for (at, (slot, &index)) in slots.iter_mut().zip(indices).enumerate() {
         if AHEAD > 0 {
             let later = indices.get(at + AHEAD);
-            prefetch(later.and_then(|&later| circles.get(later as usize)));
+            prefetch_whole(later.and_then(|&later| circles.get(later as usize)));
         }
         *slot = circles[index as usize];
     }
