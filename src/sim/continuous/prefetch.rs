@@ -10,7 +10,7 @@ use bevy::math::DVec2;
 
 use super::impact::Impact;
 use super::state::{Mover, Timeline};
-use crate::sim::cache::{PREFETCH_MIN_BALLS, prefetch};
+use crate::sim::cache::{PREFETCH_MIN_BALLS, prefetch, prefetch_whole};
 use crate::sim::geometry::circle::Circle;
 
 /// How many of the step's first predictions ahead [`Timeline::prefetch_coming`] loads the
@@ -119,13 +119,9 @@ pub(super) fn prefetch_inputs(
     prefetch(held.get(ball));
 }
 
-/// Loads the mover in `slot`, if any.
+/// Loads the mover in `slot`, if any: both cache lines a mover (72 B) spans.
 pub(super) fn prefetch_mover(movers: &[Mover], slot: u32) {
-    // A mover spans two cache lines: its first field and its last but one bring both (its
-    // layout is fixed: `repr(C)`).
-    let mover = movers.get(slot as usize);
-    prefetch(mover.map(|mover| &mover.center));
-    prefetch(mover.map(|mover| &mover.hits));
+    prefetch_whole(movers.get(slot as usize));
 }
 
 #[cfg(test)]
