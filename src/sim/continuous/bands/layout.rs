@@ -33,7 +33,7 @@ impl Survey {
                 for circle in circles[balls.clone()].iter().step_by(BINNED_EVERY) {
                     bins[bin_of(circle.center.y)] += 1;
                 }
-                let radii = Extent::of(balls, |index| circles[index]);
+                let radii = Extent::of(&circles[balls]);
                 (radii.radius_sum, radii.largest_radius, bins)
             },
         );

@@ -1,8 +1,6 @@
 //! The grid's first pass over the balls: the box of their centres, the sum of their radii
 //! and the largest radius ([`Extent`]), in four lanes so that no ball waits on the one before.
 
-use std::ops::Range;
-
 use bevy::math::DVec2;
 
 use crate::sim::geometry::circle::Circle;
@@ -26,19 +24,20 @@ impl Extent {
         largest_radius: 0.0,
     };
 
-    /// The circles `circle_at(index)` for `indices`, in four lanes that do not wait on one
-    /// another (the sum's rounding is fixed by the indices alone).
-    pub fn of(indices: Range<usize>, circle_at: impl Fn(usize) -> Circle) -> Self {
+    /// The extent of `circles`, in four lanes that do not wait on one another: the `k`th of
+    /// each run of four in lane `k`, the last few in the first (the sum's rounding is fixed by
+    /// the circles' order alone).
+    pub fn of(circles: &[Circle]) -> Self {
         let mut lanes = [Self::NONE; 4];
-        let mut next = indices.start;
-        while next + 4 <= indices.end {
-            for (lane, extent) in lanes.iter_mut().enumerate() {
-                *extent = extent.with(circle_at(next + lane));
+        let runs = circles.chunks_exact(4);
+        let rest = runs.remainder();
+        for run in runs {
+            for (extent, &circle) in lanes.iter_mut().zip(run) {
+                *extent = extent.with(circle);
             }
-            next += 4;
         }
-        for index in next..indices.end {
-            lanes[0] = lanes[0].with(circle_at(index));
+        for &circle in rest {
+            lanes[0] = lanes[0].with(circle);
         }
         let [a, b, c, d] = lanes;
         a.joined(b).joined(c.joined(d))
@@ -80,7 +79,8 @@ mod tests {
             Circle::new(DVec2::new(x, y), 1.0 + (k * 31 % 700) as f64 / 64.0)
         };
         for balls in [0..0, 3..4, 0..3, 5..9, 2..9, 0..4_099, 17..4_113] {
-            let lanes = Extent::of(balls.clone(), circle_at);
+            let circles: Vec<Circle> = balls.clone().map(circle_at).collect();
+            let lanes = Extent::of(&circles);
             let one_by_one = balls
                 .clone()
                 .map(circle_at)
@@ -88,7 +88,7 @@ mod tests {
             let found = |e: Extent| (e.min, e.max, e.radius_sum, e.largest_radius);
             assert_eq!(found(lanes), found(one_by_one), "balls {balls:?}");
         }
-        let some = Extent::of(0..100, circle_at);
+        let some = Extent::of(&(0..100).map(circle_at).collect::<Vec<_>>());
         assert!(some.min.x < some.max.x && some.min.y < some.max.y && some.radius_sum > 100.0);
     }
 }

@@ -74,13 +74,13 @@ fn is_big(radius: f64, big_limit: f64) -> bool {
 impl UniformGrid {
     /// Sorts `circles` into cells, the big ones apart.
     pub fn rebuild(&mut self, circles: &[Circle]) {
-        let (count, circle_at) = (circles.len(), |index: usize| circles[index]);
+        let count = circles.len();
         // The extent, the radii's sum and the largest radius in one pass, in pieces (on the
         // compute pool for many balls): the pieces' sums are added in their order, and a
         // piece's size is fixed, so the mean's rounding never depends on the threads.
         let parallel = worth_splitting(count);
         let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
-            Extent::of(balls, circle_at)
+            Extent::of(&circles[balls])
         });
         let all = by_piece.into_iter().fold(Extent::NONE, Extent::joined);
         let (mut min, mut max, radius_sum) = (all.min, all.max, all.radius_sum);
@@ -91,8 +91,8 @@ impl UniformGrid {
             all.largest_radius
         } else {
             let by_piece = in_pieces(piece_ranges(count), parallel, |balls| {
-                balls
-                    .map(&circle_at)
+                circles[balls]
+                    .iter()
                     .filter(|circle| !is_big(circle.radius, big_limit))
                     .fold(0.0_f64, |largest, circle| largest.max(circle.radius))
             });
@@ -112,7 +112,7 @@ impl UniformGrid {
             .chunks_mut(BALLS_PER_PIECE)
             .zip(piece_ranges(count));
         in_pieces(cell_pieces, parallel, |(cell_of, balls)| {
-            for (cell, circle) in cell_of.iter_mut().zip(balls.map(&circle_at)) {
+            for (cell, circle) in cell_of.iter_mut().zip(&circles[balls]) {
                 *cell = if is_big(circle.radius, big_limit) {
                     NO_CELL
                 } else {
