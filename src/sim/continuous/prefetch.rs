@@ -36,7 +36,9 @@ impl Timeline {
     /// first predictions, a few places ahead, a stage each, once for each of them taken (an
     /// impact predicted since, taken, leaves them where they were); for the earliest impact
     /// predicted since, a stage at each call while it stays the earliest, so that no stage
-    /// waits for what the one before is still loading. Nothing here changes a result.
+    /// waits for what the one before is still loading. A first prediction already stale
+    /// when its later stages come due (a ball of it hit since) has them skipped: it will be
+    /// skipped when taken. Nothing here changes a result.
     pub(super) fn prefetch_coming(&mut self) {
         let taken = self.queue.first_taken();
         if self.first_loaded != Some(taken) {
@@ -51,10 +53,14 @@ impl Timeline {
         if let Some(&further) = self.queue.ahead(2 * PREFETCH_DISTANCE) {
             self.prefetch_balls(further);
         }
-        if let Some(middle) = self.queue.ahead(PREFETCH_DISTANCE * 3 / 2) {
+        if let Some(middle) = self.queue.ahead(PREFETCH_DISTANCE * 3 / 2)
+            && self.still_holds(middle)
+        {
             self.grid.prefetch_cell_starts_around(middle.a as usize);
         }
-        if let Some(nearer) = self.queue.ahead(PREFETCH_DISTANCE) {
+        if let Some(nearer) = self.queue.ahead(PREFETCH_DISTANCE)
+            && self.still_holds(nearer)
+        {
             self.grid.prefetch_cells_around(nearer.a as usize);
         }
     }
@@ -77,6 +83,15 @@ impl Timeline {
             _ => {}
         }
         self.later_loaded = Some((later, stage.saturating_add(1)));
+    }
+
+    /// Whether neither ball of `impact` has been hit since it was predicted, as far as the
+    /// timeline knows now: one that has is skipped when taken, and nothing its search would
+    /// read needs loading. Its balls' movers were asked for a stage before.
+    fn still_holds(&self, impact: &Impact) -> bool {
+        let hits = |slot: u32| self.movers.get(slot as usize).map(|mover| mover.hits);
+        hits(impact.a) == Some(impact.hits_a)
+            && (impact.wall().is_some() || hits(impact.other) == Some(impact.hits_other))
     }
 
     /// Loads the movers of `impact`'s balls and their slots in the grid (the second's circle
@@ -144,6 +159,33 @@ mod tests {
                 prefetch_inputs(inputs, &order, slot);
             }
         }
+    }
+
+    #[test]
+    fn an_impact_holds_for_the_loads_until_one_of_its_balls_is_hit_again() {
+        let party = |slot: usize, hits: u32| Party {
+            slot,
+            index: slot as u32,
+            hits,
+        };
+        let mut timeline = Timeline {
+            movers: vec![Mover::default(); 4],
+            ..Timeline::default()
+        };
+        let between = Impact::between(0.003, party(1, 0), party(2, 0));
+        let wall = Impact::with_wall(0.004, party(3, 0), crate::sim::geometry::Wall::Left);
+        assert!(timeline.still_holds(&between) && timeline.still_holds(&wall));
+        // Either ball of a pair hit since: stale; a wall's impact looks at its ball alone.
+        timeline.movers[2].hits = 1;
+        assert!(!timeline.still_holds(&between));
+        assert!(timeline.still_holds(&Impact::between(0.005, party(1, 0), party(2, 1))));
+        timeline.movers[1].hits = 1;
+        assert!(!timeline.still_holds(&Impact::between(0.005, party(1, 0), party(2, 1))));
+        timeline.movers[3].hits = 2;
+        assert!(!timeline.still_holds(&wall));
+        assert!(timeline.still_holds(&Impact::with_wall(0.006, party(3, 2), wall.wall().unwrap())));
+        // A slot past the movers (never so on the timeline) holds nothing.
+        assert!(!timeline.still_holds(&Impact::between(0.007, party(1, 1), party(9, 0))));
     }
 
     #[test]
