@@ -57,6 +57,25 @@ impl ImpactQueue {
         self.later.earliest()
     }
 
+    /// Whether an impact left comes before `impact` (in [`Impact`]'s order).
+    pub fn has_before(&self, impact: &Impact) -> bool {
+        self.sorted
+            .get(self.next)
+            .is_some_and(|first| first < impact)
+            || self.later.earliest().is_some_and(|later| later < impact)
+    }
+
+    /// Puts back `impact`, the last one [`pop`](Self::pop) took: the queue then gives the
+    /// impacts it would have given had it never been taken (their order is total: no two
+    /// different impacts compare equal).
+    pub fn put_back(&mut self, impact: Impact) {
+        if self.next > 0 && self.sorted[self.next - 1] == impact {
+            self.next -= 1;
+        } else {
+            self.later.push(impact);
+        }
+    }
+
     /// Takes the earliest impact left.
     pub fn pop(&mut self) -> Option<Impact> {
         let first = self.sorted.get(self.next);
@@ -297,6 +316,63 @@ mod tests {
                 "{most_waiting} waiting at most"
             );
         }
+    }
+
+    #[test]
+    fn an_impact_put_back_comes_out_where_it_would_have() {
+        // As the timeline does: the next impact taken before the last one's new predictions
+        // are queued, and put back if one of them comes first. Equal times on purpose.
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let mut impact = |time: f64| {
+            let mut ball = || {
+                let index = rng.random_range(0..50u32);
+                let hits = rng.random_range(0..3);
+                Party {
+                    slot: index as usize,
+                    index,
+                    hits,
+                }
+            };
+            let (i, j) = (ball(), ball());
+            Impact::between(time, i, j)
+        };
+        let first: Vec<Impact> = (0..2000).map(|k| impact((k % 40) as f64 * 0.01)).collect();
+        let mut queue = ImpactQueue::default();
+        queue.start(first.iter().copied(), 0.4);
+        let mut heap: BinaryHeap<Reverse<Impact>> = first.iter().copied().map(Reverse).collect();
+        let (mut taken, mut expected, mut put_back) = (Vec::new(), Vec::new(), [0, 0]);
+        for round in 0..6000 {
+            let now = taken.last().map_or(0.0, |i: &Impact| i.time);
+            let new: Vec<Impact> = (0..round % 3)
+                .map(|k| impact(now + ((round + k) % 5) as f64 * 0.004))
+                .collect();
+            heap.extend(new.iter().copied().map(Reverse));
+            let mut next = queue.pop();
+            new.into_iter().for_each(|impact| queue.push(impact));
+            if let Some(impact) = next
+                && queue.has_before(&impact)
+            {
+                let from_first = queue.next > 0 && queue.sorted[queue.next - 1] == impact;
+                put_back[usize::from(from_first)] += 1;
+                queue.put_back(impact);
+                next = queue.pop();
+            }
+            match (next, heap.pop()) {
+                (Some(a), Some(Reverse(b))) => {
+                    taken.push(a);
+                    expected.push(b);
+                }
+                (None, None) => break,
+                (a, b) => panic!("one source ran dry first: {a:?} {b:?}"),
+            }
+        }
+        assert!(taken.len() > 4000, "{} taken", taken.len());
+        assert_eq!(taken, expected);
+        // Put back both to the first predictions and among the later ones.
+        assert!(
+            put_back[0] > 50 && put_back[1] > 50,
+            "{put_back:?} put back"
+        );
     }
 
     #[test]

@@ -7,7 +7,7 @@ use super::impact::Impact;
 use super::predict::{SWEPT_MARGIN, pair_time, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
-use super::state::{Mover, StepSpec, Timeline};
+use super::state::{Mover, StepSpec, Timeline, Untimed};
 use crate::sim::geometry::circle::{Circle, within_reach};
 
 impl Timeline {
@@ -42,8 +42,11 @@ impl Timeline {
     /// The balls the search finds are listed first, each one's mover loaded into the cache
     /// as it is found ([`prefetch_mover`]), and timed after: their loads overlap (at a
     /// million balls the movers lie well past the cache: −3% there, −1% at 100,000). The
-    /// search comes before the two balls take their new paths, and the timing after, so that
-    /// those loads have that long too to arrive (about −2% at both sizes).
+    /// search comes before the two balls take their new paths, so that those loads have that
+    /// long too to arrive (about −2% at both sizes), and the timing later still: the call
+    /// leaves it to [`time_what_was_found`](Self::time_what_was_found), which the timeline
+    /// calls once it has taken the next impact and started that one's loads (a million
+    /// balls −2%).
     pub(super) fn predict_for_both(&mut self, (a, b): (usize, usize), now: f64, spec: StepSpec) {
         let spent = |slot: usize| self.movers[slot].hits == spec.hit_limit;
         if spent(a) || spent(b) {
@@ -72,7 +75,27 @@ impl Timeline {
             });
         self.take_new_path(a, swept[0], now, spec);
         self.take_new_path(b, swept[1], now, spec);
-        let (balls, queue, end) = (self.movers.as_slice(), &mut self.queue, spec.dt);
+        self.untimed = Some(Untimed {
+            slots: (a, b),
+            now,
+            a_finds_b,
+            b_finds_a,
+        });
+    }
+
+    /// Queues the impacts of what the last [`predict_for_both`](Self::predict_for_both)
+    /// found, if not yet done. It must come before any impact after that one is handled.
+    pub(super) fn time_what_was_found(&mut self, end: f64) {
+        let Some(Untimed {
+            slots: (a, b),
+            now,
+            a_finds_b,
+            b_finds_a,
+        }) = self.untimed.take()
+        else {
+            return;
+        };
+        let (balls, queue) = (self.movers.as_slice(), &mut self.queue);
         for &(k, other) in self.found.iter() {
             let slot = [a, b][k as usize];
             queue_pair_impact(balls, (slot, other as usize), now, end, queue);
@@ -215,6 +238,7 @@ mod tests {
             one_at_a_time.predict_for(a, impact.time, spec);
             one_at_a_time.predict_for(b, impact.time, spec);
             both.predict_for_both((a, b), impact.time, spec);
+            both.time_what_was_found(spec.dt);
         }
         assert!(
             redirected > 500 && taken > redirected && with_big > 5 && kept_apart > 100,

@@ -221,6 +221,16 @@ impl Mover {
 }
 
 /// The continuous mode's working state, kept between steps to reuse its buffers.
+/// An impact between the balls in `slots` at `now`, whose search's finds wait to be timed,
+/// and which of its two balls' own pairs are timed apart.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Untimed {
+    pub slots: (usize, usize),
+    pub now: f64,
+    pub a_finds_b: bool,
+    pub b_finds_a: bool,
+}
+
 #[derive(Resource, Debug, Default)]
 pub struct Timeline {
     /// Each ball's circle swept over the whole step, sorted into cells; during the timeline,
@@ -246,6 +256,8 @@ pub struct Timeline {
     /// The balls the search after an impact found, `(which of its two balls, slot)`, before
     /// each is timed (`Timeline::predict_for_both`).
     pub(super) found: Vec<(u8, u32)>,
+    /// The impact whose found balls are still to be timed (`Timeline::time_what_was_found`).
+    pub(super) untimed: Option<Untimed>,
     /// How many of the step's first predictions had been taken when the loads ahead last
     /// loaded the ones ahead of them (`prefetch.rs`): until that changes, they are loaded.
     pub(super) first_loaded: Option<usize>,

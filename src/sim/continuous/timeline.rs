@@ -65,10 +65,7 @@ impl Timeline {
         self.start(spec.dt);
         let mut last = None;
         let prefetching = self.worth_prefetching();
-        while let Some(impact) = self.queue.pop() {
-            if prefetching {
-                self.prefetch_coming();
-            }
+        while let Some(impact) = self.take_next(prefetching, spec.dt) {
             if !self.is_current(&impact, spec.hit_limit) {
                 continue;
             }
@@ -82,6 +79,30 @@ impl Timeline {
             }
         }
         self.move_to_the_end(circles, velocities, (held, stopped), spec);
+    }
+
+    /// The next impact to handle, the earliest left, loading ahead what the coming ones will
+    /// read if `prefetching`. The last collision's finds are timed only here
+    /// (`time_what_was_found`), once the next impact has been taken and its loads started,
+    /// so that their movers have had longer to arrive; should one of them come first, the
+    /// one taken goes back. The impacts' order is total, so the queue gives what it would
+    /// have given with them timed at once.
+    fn take_next(&mut self, prefetching: bool, end: f64) -> Option<Impact> {
+        loop {
+            let taken = self.queue.pop();
+            if prefetching {
+                self.prefetch_coming();
+            }
+            if self.untimed.is_none() {
+                return taken;
+            }
+            self.time_what_was_found(end);
+            match taken {
+                Some(impact) if self.queue.has_before(&impact) => self.queue.put_back(impact),
+                None => {}
+                Some(impact) => return Some(impact),
+            }
+        }
     }
 
     /// The end of a step whose impacts ran in bands that held ([`Bands`](super::bands::Bands)):
