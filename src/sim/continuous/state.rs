@@ -220,9 +220,9 @@ impl Mover {
     }
 }
 
-/// The continuous mode's working state, kept between steps to reuse its buffers.
-/// An impact between the balls in `slots` at `now`, whose search's finds wait to be timed,
-/// and which of its two balls' own pairs are timed apart.
+/// A collision between the balls in `slots` at `now` whose search's finds wait to be timed
+/// (`Timeline::time_what_was_found`), and whether the two balls' own pair is timed apart,
+/// from either side (`Timeline::predict_for_both`).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Untimed {
     pub slots: (usize, usize),
@@ -231,6 +231,7 @@ pub(super) struct Untimed {
     pub b_finds_a: bool,
 }
 
+/// The continuous mode's working state, kept between steps to reuse its buffers.
 #[derive(Resource, Debug, Default)]
 pub struct Timeline {
     /// Each ball's circle swept over the whole step, sorted into cells; during the timeline,
@@ -254,7 +255,7 @@ pub struct Timeline {
     /// Contacts for the discrete response of a step cut short.
     pub(super) fallback: FoundInBands<IndexedContact>,
     /// The balls the search after an impact found, `(which of its two balls, slot)`, before
-    /// each is timed (`Timeline::predict_for_both`).
+    /// each is timed (`Timeline::predict_for_both`, `Timeline::time_what_was_found`).
     pub(super) found: Vec<(u8, u32)>,
     /// The impact whose found balls are still to be timed (`Timeline::time_what_was_found`).
     pub(super) untimed: Option<Untimed>,
