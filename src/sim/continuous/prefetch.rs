@@ -85,15 +85,6 @@ impl Timeline {
         self.later_loaded = Some((later, stage.saturating_add(1)));
     }
 
-    /// Whether neither ball of `impact` has been hit since it was predicted, as far as the
-    /// timeline knows now: one that has is skipped when taken, and nothing its search would
-    /// read needs loading. Its balls' movers were asked for a stage before.
-    fn still_holds(&self, impact: &Impact) -> bool {
-        let hits = |slot: u32| self.movers.get(slot as usize).map(|mover| mover.hits);
-        hits(impact.a) == Some(impact.hits_a)
-            && (impact.wall().is_some() || hits(impact.other) == Some(impact.hits_other))
-    }
-
     /// Loads the movers of `impact`'s balls and their slots in the grid (the second's circle
     /// is read to tell whether the first's search would find it).
     fn prefetch_balls(&self, impact: Impact) {

@@ -254,24 +254,45 @@ mod tests {
     use super::*;
     use crate::sim::continuous::impact::Party;
 
+    /// An impact at `time` between two of 50 balls, each with 0 to 2 hits.
+    fn random_impact(rng: &mut ChaCha8Rng, time: f64) -> Impact {
+        let mut ball = || {
+            let index = rng.random_range(0..50u32);
+            Party {
+                slot: index as usize,
+                index,
+                hits: rng.random_range(0..3),
+            }
+        };
+        let (i, j) = (ball(), ball());
+        Impact::between(time, i, j)
+    }
+
+    /// `next`, from the queue, and the heap's next, each kept in its list; whether there were
+    /// any (both sources must run dry together).
+    fn take_alike(
+        next: Option<Impact>,
+        heap: &mut BinaryHeap<Reverse<Impact>>,
+        (taken, expected): (&mut Vec<Impact>, &mut Vec<Impact>),
+    ) -> bool {
+        match (next, heap.pop()) {
+            (Some(a), Some(Reverse(b))) => {
+                taken.push(a);
+                expected.push(b);
+                true
+            }
+            (None, None) => false,
+            (a, b) => panic!("one source ran dry first: {a:?} {b:?}"),
+        }
+    }
+
     #[test]
     fn the_two_sources_come_out_as_one_heap_of_them_all_would() {
         // The buckets span the step's first impacts (0.4 s), a tenth of it, ten times it, or
         // nothing (one bucket).
         for horizon in [0.4, 0.04, 4.0, 0.0, f64::NAN] {
             let mut rng = ChaCha8Rng::seed_from_u64(5);
-            let mut impact = |time: f64| {
-                let ball = |rng: &mut ChaCha8Rng| {
-                    let index = rng.random_range(0..50u32);
-                    Party {
-                        slot: index as usize,
-                        index,
-                        hits: rng.random_range(0..3),
-                    }
-                };
-                let (i, j) = (ball(&mut rng), ball(&mut rng));
-                Impact::between(time, i, j)
-            };
+            let mut impact = |time: f64| random_impact(&mut rng, time);
             // Equal times on purpose: the balls' order must break the ties the same way.
             let first: Vec<Impact> = (0..3000).map(|k| impact((k % 40) as f64 * 0.01)).collect();
             let mut queue = ImpactQueue::default();
@@ -297,13 +318,8 @@ mod tests {
                     let waiting = queue.later.lists.iter().map(Vec::len).sum::<usize>();
                     most_waiting = most_waiting.max(waiting);
                 }
-                match (queue.pop(), heap.pop()) {
-                    (Some(a), Some(Reverse(b))) => {
-                        taken.push(a);
-                        expected.push(b);
-                    }
-                    (None, None) => break,
-                    (a, b) => panic!("one source ran dry first: {a:?} {b:?}"),
+                if !take_alike(queue.pop(), &mut heap, (&mut taken, &mut expected)) {
+                    break;
                 }
             }
             assert!(taken.len() > 4000, "{} taken", taken.len());
@@ -323,19 +339,7 @@ mod tests {
         // As the timeline does: the next impact taken before the last one's new predictions
         // are queued, and put back if one of them comes first. Equal times on purpose.
         let mut rng = ChaCha8Rng::seed_from_u64(8);
-        let mut impact = |time: f64| {
-            let mut ball = || {
-                let index = rng.random_range(0..50u32);
-                let hits = rng.random_range(0..3);
-                Party {
-                    slot: index as usize,
-                    index,
-                    hits,
-                }
-            };
-            let (i, j) = (ball(), ball());
-            Impact::between(time, i, j)
-        };
+        let mut impact = |time: f64| random_impact(&mut rng, time);
         let first: Vec<Impact> = (0..2000).map(|k| impact((k % 40) as f64 * 0.01)).collect();
         let mut queue = ImpactQueue::default();
         queue.start(first.iter().copied(), 0.4);
@@ -357,13 +361,8 @@ mod tests {
                 queue.put_back(impact);
                 next = queue.pop();
             }
-            match (next, heap.pop()) {
-                (Some(a), Some(Reverse(b))) => {
-                    taken.push(a);
-                    expected.push(b);
-                }
-                (None, None) => break,
-                (a, b) => panic!("one source ran dry first: {a:?} {b:?}"),
+            if !take_alike(next, &mut heap, (&mut taken, &mut expected)) {
+                break;
             }
         }
         assert!(taken.len() > 4000, "{} taken", taken.len());

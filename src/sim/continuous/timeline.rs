@@ -153,19 +153,24 @@ impl Timeline {
     /// Whether `impact` still holds: neither ball has been hit since it was predicted, and
     /// neither has used up its `hit_limit` hits for the step (which cuts the step short).
     fn is_current(&mut self, impact: &Impact, hit_limit: u32) -> bool {
-        let hits_a = self.movers[impact.a as usize].hits;
-        let hits_other = match impact.wall() {
-            Some(_) => 0,
-            None => self.movers[impact.other as usize].hits,
-        };
-        if hits_a != impact.hits_a || hits_other != impact.hits_other {
+        if !self.still_holds(impact) {
             return false; // stale: a ball in it has been hit since
         }
-        if hits_a == hit_limit || hits_other == hit_limit {
+        // Its balls' hits are still the ones it names (a wall's are 0).
+        if impact.hits_a == hit_limit || impact.hits_other == hit_limit {
             self.cut_short = true;
             return false;
         }
         true
+    }
+
+    /// Whether neither ball of `impact` has been hit since it was predicted: one that has is
+    /// stale, skipped when taken ([`is_current`](Self::is_current)), and the loads ahead
+    /// skip what its search would read (`prefetch.rs`).
+    pub(super) fn still_holds(&self, impact: &Impact) -> bool {
+        let hits = |slot: u32| self.movers.get(slot as usize).map(|mover| mover.hits);
+        hits(impact.a) == Some(impact.hits_a)
+            && (impact.wall().is_some() || hits(impact.other) == Some(impact.hits_other))
     }
 
     /// Ball `impact.a` reaches `wall`: it bounces if it still moves into it, or stops
