@@ -44,6 +44,36 @@ pub fn approach_time(a: Circle, velocity_a: DVec2, b: Circle, velocity_b: DVec2)
     time_of_impact(a, velocity_a, b, velocity_b)
 }
 
+/// [`approach_time`] within `end` seconds, worked out whole whatever the pair does, for pairs
+/// timed a batch at a time: the time, and whether it holds. It holds exactly when
+/// `approach_time(..).filter(|&t| t <= end)` gives a time, and then it is that time to the
+/// bit: the same operations in the same order, with the early returns turned into tests that
+/// are all made (a negative discriminant's root is NaN, which no test passes).
+#[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x <= 0.0)` lets NaN through as the returns do
+pub fn approach_time_within(
+    (a, velocity_a): (Circle, DVec2),
+    (b, velocity_b): (Circle, DVec2),
+    end: f64,
+) -> (f64, bool) {
+    let offset = b.center - a.center;
+    let closing = (velocity_a - velocity_b).dot(offset);
+    let min_speed = MIN_APPROACH_SPEED * MIN_APPROACH_SPEED;
+    let closes = !(closing <= 0.0) & !(closing * closing <= min_speed * offset.length_squared());
+    // `time_of_impact`'s steps.
+    let velocity = velocity_b - velocity_a;
+    let reach = a.radius + b.radius;
+    let half_b = offset.dot(velocity);
+    let c = offset.length_squared() - reach * reach;
+    let discriminant = half_b * half_b - velocity.length_squared() * c;
+    let time = if c <= 0.0 {
+        0.0
+    } else {
+        c / (-half_b + discriminant.sqrt())
+    };
+    (time, closes & !(half_b >= 0.0) & (time <= end))
+}
+
 /// `other` values from here up name a wall, below it a ball.
 const WALL_BASE: u32 = u32::MAX - 3;
 
@@ -182,6 +212,43 @@ mod tests {
             (slots.a, slots.other),
             (99, 92),
             "the lower index's slot first"
+        );
+    }
+
+    #[test]
+    fn the_approach_time_worked_out_whole_is_approach_time_to_the_bit() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(41);
+        let (mut met, mut touching, mut passing, mut apart) = (0, 0, 0, 0);
+        for case in 0..40_000 {
+            let mut point =
+                || DVec2::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0));
+            let (a, b) = (Circle::new(point(), 6.0), Circle::new(point(), 9.0));
+            let (mut velocity_a, velocity_b) = (point() * 30.0, point() * 30.0);
+            match case % 50 {
+                0 => velocity_a = velocity_b, // not closing at all
+                1 => velocity_a = velocity_b + DVec2::new(1e-12, 0.0), // closing too slowly
+                2 => velocity_a.x = f64::NAN,
+                _ => {}
+            }
+            let end = rng.random_range(0.001..0.2);
+            let alone = approach_time(a, velocity_a, b, velocity_b).filter(|&t| t <= end);
+            let (time, holds) = approach_time_within((a, velocity_a), (b, velocity_b), end);
+            assert_eq!(
+                holds.then_some(time.to_bits()),
+                alone.map(f64::to_bits),
+                "{a:?} {velocity_a} {b:?} {velocity_b} {end}"
+            );
+            met += usize::from(alone.is_some_and(|t| t > 0.0));
+            touching += usize::from(alone == Some(0.0));
+            passing += usize::from(
+                alone.is_none() && approach_time(a, velocity_a, b, velocity_b).is_some(),
+            );
+            apart += usize::from(alone.is_none());
+        }
+        assert!(
+            met > 1_000 && touching > 100 && passing > 100 && apart > 1_000,
+            "{met} met, {touching} touching, {passing} too late, {apart} apart"
         );
     }
 

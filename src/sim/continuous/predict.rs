@@ -16,7 +16,9 @@ use std::ops::Range;
 
 use bevy::math::DVec2;
 
-use super::impact::{Impact, Prediction, approach_time, swept_circle, swept_circle_under};
+use super::impact::{
+    Impact, Prediction, approach_time, approach_time_within, swept_circle, swept_circle_under,
+};
 use super::prefetch::{INPUTS_AHEAD, prefetch_inputs};
 use super::state::{Mover, StepSpec, Timeline};
 use crate::sim::geometry::circle::{Circle, overlapping, within_reach};
@@ -99,14 +101,16 @@ impl Timeline {
         // The big balls' pairs are searched with the first row.
         place(grid.small_count()..order.len(), movers, found);
         place(grid.slots_of_row(0), movers, found);
+        let mut pairs = FirstPairs::new();
         for row in 0..grid.rows() {
             if row + 1 < grid.rows() {
                 place(grid.slots_of_row(row + 1), movers, found);
             }
             grid.for_each_pair_within_reach_in_rows(row..row + 1, |i, j, _, _| {
-                predict_pair(movers, (i, j), spec.dt, found);
+                pairs.add((i, j), movers, spec.dt, found);
             });
         }
+        pairs.time_all(movers, spec.dt, found);
     }
 
     /// Every pair's impact, through the pairs of swept circles the grid finds touching (the
@@ -115,9 +119,11 @@ impl Timeline {
     fn predict_every_pair(&mut self, dt: f64) {
         let movers = &self.movers;
         search_in_bands(&self.grid, &mut self.predictions, |grid, rows, found| {
+            let mut pairs = FirstPairs::new();
             grid.for_each_pair_within_reach_in_rows(rows, |i, j, _, _| {
-                predict_pair(movers, (i, j), dt, found);
+                pairs.add((i, j), movers, dt, found);
             });
+            pairs.time_all(movers, dt, found);
         });
     }
 
@@ -239,6 +245,30 @@ pub(super) fn pair_time(a: &Mover, b: &Mover, now: f64, end: f64) -> Option<f64>
     time.map(|t| now + t).filter(|&t| t <= end)
 }
 
+/// [`pair_time`] as a time and whether it holds, worked out whole for two balls with the same
+/// acceleration ([`approach_time_within`]): it holds exactly when `pair_time` gives a time,
+/// and then it is that time to the bit.
+#[inline]
+pub(super) fn pair_time_within(a: &Mover, b: &Mover, now: f64, end: f64) -> (f64, bool) {
+    if a.accel != b.accel {
+        let time = pair_time(a, b, now, end);
+        return (time.unwrap_or(0.0), time.is_some());
+    }
+    let (center_a, center_b) = (a.center_at(now), b.center_at(now));
+    let (velocity_a, velocity_b) = (a.velocity_at(now), b.velocity_at(now));
+    let (circle_a, circle_b) = (
+        Circle::new(center_a, a.radius),
+        Circle::new(center_b, b.radius),
+    );
+    let (time, holds) = approach_time_within(
+        (circle_a, velocity_a),
+        (circle_b, velocity_b),
+        f64::INFINITY,
+    );
+    let time = now + time;
+    (time, holds & (time <= end))
+}
+
 /// [`pair_time`] from the start of the step, for two balls that have not moved yet (each
 /// mover's clock at 0): where they are and how fast they go are the movers' own, not worked
 /// out for the time 0 (the same numbers: a zero added to a coordinate changes at most the
@@ -295,6 +325,79 @@ fn predict_pair(movers: &[Mover], (i, j): (u32, u32), dt: f64, found: &mut Vec<P
     }
 }
 
+/// How many of the first search's pairs within reach [`FirstPairs`] times at once.
+const PAIR_BATCH: usize = 64;
+
+/// The first search's pairs within reach, timed a batch at a time. Whether a pair meets
+/// within the step is a matter of chance, so timing each pair as it was found mispredicted a
+/// branch or two a pair, and each pair's square root and division waited for the branches
+/// before them; a batch is timed without a branch per pair ([`approach_time_within`]), each
+/// pair's impact written whether it holds or not and kept if it does. It finds what
+/// [`predict_pair`] finds for each pair, in another order (a batch's impacts after its
+/// overlaps), which the queue's sort undoes; the overlaps keep their order.
+struct FirstPairs {
+    pairs: [(u32, u32); PAIR_BATCH],
+    len: usize,
+    impacts: [Impact; PAIR_BATCH],
+}
+
+impl FirstPairs {
+    fn new() -> Self {
+        let none = Impact::with_wall(
+            0.0,
+            Mover::default().party(0),
+            crate::sim::geometry::Wall::Left,
+        );
+        Self {
+            pairs: [(0, 0); PAIR_BATCH],
+            len: 0,
+            impacts: [none; PAIR_BATCH],
+        }
+    }
+
+    /// Adds the pair of slots `(i, j)`, in either order, timing the batch once it is full.
+    #[inline]
+    fn add(&mut self, pair: (u32, u32), movers: &[Mover], dt: f64, found: &mut Vec<Prediction>) {
+        // `len` is below the batch's size here: the modulo only tells the compiler so.
+        self.pairs[self.len % PAIR_BATCH] = pair;
+        self.len += 1;
+        if self.len == PAIR_BATCH {
+            self.time_all(movers, dt, found);
+        }
+    }
+
+    /// Times the pairs added since the last call: what [`predict_pair`] finds for each.
+    fn time_all(&mut self, movers: &[Mover], dt: f64, found: &mut Vec<Prediction>) {
+        let mut kept = 0;
+        for &(i, j) in &self.pairs[..self.len] {
+            let (a, b) = (i.min(j), i.max(j));
+            let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
+            if overlapping(mover_a.circle(), mover_b.circle()) {
+                found.push(Prediction::Overlap(a, b));
+            }
+            let (time, holds) = first_pair_time_within(mover_a, mover_b, dt);
+            let (party_a, party_b) = (mover_a.party(a as usize), mover_b.party(b as usize));
+            self.impacts[kept % PAIR_BATCH] = Impact::between(time, party_a, party_b);
+            kept += usize::from(holds);
+        }
+        let impacts = self.impacts[..kept].iter();
+        found.extend(impacts.map(|&impact| Prediction::Impact(impact)));
+        self.len = 0;
+    }
+}
+
+/// [`first_pair_time`] as a time and whether it holds, worked out whole for two balls
+/// with the same acceleration ([`approach_time_within`]).
+#[inline]
+fn first_pair_time_within(a: &Mover, b: &Mover, end: f64) -> (f64, bool) {
+    if a.accel != b.accel {
+        let time = pair_time(a, b, 0.0, end);
+        return (time.unwrap_or(0.0), time.is_some());
+    }
+    let (velocity_a, velocity_b) = (a.moving_velocity(), b.moving_velocity());
+    approach_time_within((a.circle(), velocity_a), (b.circle(), velocity_b), end)
+}
+
 #[cfg(test)]
 mod tests {
     use rand::{RngExt, SeedableRng};
@@ -332,7 +435,8 @@ mod tests {
             }
             mover
         };
-        let (mut met, mut apart) = (0, 0);
+        let (mut met, mut apart, mut met_later) = (0, 0, 0);
+        let held = |(time, holds): (f64, bool)| holds.then_some(time.to_bits());
         for k in 0..20_000 {
             let (a, b) = (mover(&mut rng, k), mover(&mut rng, k / 3));
             let end = rng.random_range(0.001..0.05);
@@ -344,8 +448,74 @@ mod tests {
             );
             met += usize::from(first.is_some());
             apart += usize::from(first.is_none());
+            // Worked out whole, for the batches: the same times to the bit, from any moment.
+            let whole = held(first_pair_time_within(&a, &b, end));
+            assert_eq!(whole, first.map(f64::to_bits), "{a:?} {b:?}");
+            let now = rng.random_range(0.0..end);
+            let later = pair_time(&a, &b, now, end);
+            assert_eq!(
+                held(pair_time_within(&a, &b, now, end)),
+                later.map(f64::to_bits)
+            );
+            met_later += usize::from(later.is_some());
         }
         assert!(met > 1_000 && apart > 1_000, "{met} met, {apart} apart");
+        assert!(met_later > 1_000, "{met_later} met from a later moment");
+    }
+
+    #[test]
+    fn the_first_pairs_timed_in_batches_give_what_each_pair_timed_alone_gives() {
+        // Balls of radius 3-9 crowded enough to overlap now and then, every seventh still,
+        // under gravity (a still ball and a flying one accelerate differently).
+        let mut rng = ChaCha8Rng::seed_from_u64(29);
+        let count = 3_000;
+        let circles: Vec<Circle> = (0..count)
+            .map(|_| {
+                let center = DVec2::new(
+                    rng.random_range(-300.0..300.0),
+                    rng.random_range(-300.0..300.0),
+                );
+                Circle::new(center, rng.random_range(3.0..9.0))
+            })
+            .collect();
+        let velocities: Vec<DVec2> = (0..count)
+            .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..900.0))
+            .collect();
+        let held: Vec<bool> = (0..count).map(|k| k % 7 == 0).collect();
+        let spec = StepSpec::sixtieth(DVec2::splat(320.0), DVec2::new(0.0, -500.0));
+        let mut timeline = Timeline::default();
+        timeline.predict(&circles, &velocities, &held, spec);
+        let (grid, movers) = (&timeline.grid, &timeline.movers);
+        let (mut alone, mut batched) = (Vec::new(), Vec::new());
+        let mut pairs = FirstPairs::new();
+        let mut found = 0;
+        grid.for_each_pair_within_reach_in_rows(0..grid.rows(), |i, j, _, _| {
+            predict_pair(movers, (i, j), spec.dt, &mut alone);
+            pairs.add((i, j), movers, spec.dt, &mut batched);
+            found += 1;
+        });
+        pairs.time_all(movers, spec.dt, &mut batched);
+        assert_eq!(sorted(&batched), sorted(&alone));
+        // The overlaps in the order found: the step pushes them apart in that order.
+        let overlaps = |found: &[Prediction]| -> Vec<(u32, u32)> {
+            let overlap = |p: &Prediction| match *p {
+                Prediction::Overlap(a, b) => Some((a, b)),
+                Prediction::Impact(_) => None,
+            };
+            found.iter().filter_map(overlap).collect()
+        };
+        assert_eq!(overlaps(&batched), overlaps(&alone));
+        // Many batches, many impacts and overlaps, some pairs of a still and a flying ball.
+        let mixed = alone.iter().any(|p| {
+            matches!(*p, Prediction::Impact(Impact { a, other, .. })
+                if movers[a as usize].is_still() != movers[other as usize].is_still())
+        });
+        let impacts = alone.len() - overlaps(&alone).len();
+        assert!(
+            found > 10 * PAIR_BATCH && impacts > 200 && overlaps(&alone).len() > 20 && mixed,
+            "{found} pairs, {impacts} impacts, {} overlaps",
+            overlaps(&alone).len()
+        );
     }
 
     #[test]
