@@ -140,6 +140,7 @@ impl Timeline {
             self.slot_of[index as usize] = slot as u32;
         }
         let (movers, order, found) = (&self.movers, &self.order, &mut self.predictions);
+        let mut pairs = FirstPairs::new();
         for &slot in &self.slot_of {
             let slot = slot as usize;
             if movers[slot].is_still() {
@@ -156,9 +157,10 @@ impl Timeline {
                     {
                         return;
                     }
-                    predict_pair(movers, (slot as u32, other as u32), dt, found);
+                    pairs.add((slot as u32, other as u32), movers, dt, found);
                 });
         }
+        pairs.time_all(movers, dt, found);
     }
 }
 
@@ -269,23 +271,6 @@ pub(super) fn pair_time_within(a: &Mover, b: &Mover, now: f64, end: f64) -> (f64
     (time, holds & (time <= end))
 }
 
-/// [`pair_time`] from the start of the step, for two balls that have not moved yet (each
-/// mover's clock at 0): where they are and how fast they go are the movers' own, not worked
-/// out for the time 0 (the same numbers: a zero added to a coordinate changes at most the
-/// sign of a zero, which no comparison or product here tells apart).
-#[inline]
-fn first_pair_time(a: &Mover, b: &Mover, end: f64) -> Option<f64> {
-    debug_assert!(
-        a.clock == 0.0 && b.clock == 0.0,
-        "a ball moved before the search"
-    );
-    if a.accel != b.accel {
-        return pair_time(a, b, 0.0, end);
-    }
-    let (velocity_a, velocity_b) = (a.moving_velocity(), b.moving_velocity());
-    approach_time(a.circle(), velocity_a, b.circle(), velocity_b).filter(|&t| t <= end)
-}
-
 /// When a moving `mover` first meets a wall, from its clock on; a still one meets none, and
 /// nor does one whose path, bounded by the circle `swept`, stays clear of every wall by
 /// [`SWEPT_MARGIN`] (its own margin, against rounding).
@@ -311,20 +296,6 @@ pub(super) fn wall_time(
 /// only.
 const FEW_FLYING: usize = 4;
 
-/// What the search finds for the pair of slots `(i, j)`, in either order: an overlap at the
-/// start, an impact within the step, each naming the lower slot first.
-fn predict_pair(movers: &[Mover], (i, j): (u32, u32), dt: f64, found: &mut Vec<Prediction>) {
-    let (a, b) = (i.min(j), i.max(j));
-    let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
-    if overlapping(mover_a.circle(), mover_b.circle()) {
-        found.push(Prediction::Overlap(a, b));
-    }
-    if let Some(time) = first_pair_time(mover_a, mover_b, dt) {
-        let impact = Impact::between(time, mover_a.party(a as usize), mover_b.party(b as usize));
-        found.push(Prediction::Impact(impact));
-    }
-}
-
 /// How many of the first search's pairs within reach [`FirstPairs`] times at once.
 const PAIR_BATCH: usize = 64;
 
@@ -332,9 +303,9 @@ const PAIR_BATCH: usize = 64;
 /// within the step is a matter of chance, so timing each pair as it was found mispredicted a
 /// branch or two a pair, and each pair's square root and division waited for the branches
 /// before them; a batch is timed without a branch per pair ([`approach_time_within`]), each
-/// pair's impact written whether it holds or not and kept if it does. It finds what
-/// [`predict_pair`] finds for each pair, in another order (a batch's impacts after its
-/// overlaps), which the queue's sort undoes; the overlaps keep their order.
+/// pair's impact written whether it holds or not and kept if it does. It finds what timing
+/// each pair alone finds (the tests' `predict_pair`), in another order (a batch's impacts
+/// after its overlaps), which the queue's sort undoes; the overlaps keep their order.
 struct FirstPairs {
     pairs: [(u32, u32); PAIR_BATCH],
     len: usize,
@@ -366,7 +337,8 @@ impl FirstPairs {
         }
     }
 
-    /// Times the pairs added since the last call: what [`predict_pair`] finds for each.
+    /// Times the pairs added since the last call: for each, an overlap at the start and an
+    /// impact within the step, naming the lower slot first.
     fn time_all(&mut self, movers: &[Mover], dt: f64, found: &mut Vec<Prediction>) {
         let mut kept = 0;
         for &(i, j) in &self.pairs[..self.len] {
@@ -386,8 +358,12 @@ impl FirstPairs {
     }
 }
 
-/// [`first_pair_time`] as a time and whether it holds, worked out whole for two balls
-/// with the same acceleration ([`approach_time_within`]).
+/// When, within `end` seconds of the step's start, two balls that have not moved yet (each
+/// mover's clock at 0) first touch while closing, as a time and whether it holds: for two
+/// with the same acceleration, worked out whole from the movers' own places and velocities
+/// ([`approach_time_within`]); it holds exactly when [`pair_time`] from 0 gives a time, and
+/// then it is that time to the bit (tested: a zero added to a coordinate changes at most the
+/// sign of a zero, which no comparison or product here tells apart).
 #[inline]
 fn first_pair_time_within(a: &Mover, b: &Mover, end: f64) -> (f64, bool) {
     if a.accel != b.accel {
@@ -404,6 +380,37 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
+
+    /// [`pair_time`] from the start of the step, for two balls that have not moved yet (each
+    /// mover's clock at 0): where they are and how fast they go are the movers' own, not worked
+    /// out for the time 0 (the same numbers: a zero added to a coordinate changes at most the
+    /// sign of a zero, which no comparison or product here tells apart).
+    fn first_pair_time(a: &Mover, b: &Mover, end: f64) -> Option<f64> {
+        debug_assert!(
+            a.clock == 0.0 && b.clock == 0.0,
+            "a ball moved before the search"
+        );
+        if a.accel != b.accel {
+            return pair_time(a, b, 0.0, end);
+        }
+        let (velocity_a, velocity_b) = (a.moving_velocity(), b.moving_velocity());
+        approach_time(a.circle(), velocity_a, b.circle(), velocity_b).filter(|&t| t <= end)
+    }
+
+    /// What the search finds for the pair of slots `(i, j)`, in either order, timed alone: an
+    /// overlap at the start, an impact within the step, each naming the lower slot first.
+    fn predict_pair(movers: &[Mover], (i, j): (u32, u32), dt: f64, found: &mut Vec<Prediction>) {
+        let (a, b) = (i.min(j), i.max(j));
+        let (mover_a, mover_b) = (&movers[a as usize], &movers[b as usize]);
+        if overlapping(mover_a.circle(), mover_b.circle()) {
+            found.push(Prediction::Overlap(a, b));
+        }
+        if let Some(time) = first_pair_time(mover_a, mover_b, dt) {
+            let impact =
+                Impact::between(time, mover_a.party(a as usize), mover_b.party(b as usize));
+            found.push(Prediction::Impact(impact));
+        }
+    }
 
     /// The predictions in a fixed order, for comparing two searches.
     fn sorted(predictions: &[Prediction]) -> Vec<String> {
