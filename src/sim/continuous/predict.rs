@@ -366,6 +366,10 @@ impl FirstPairs {
 /// sign of a zero, which no comparison or product here tells apart).
 #[inline]
 fn first_pair_time_within(a: &Mover, b: &Mover, end: f64) -> (f64, bool) {
+    debug_assert!(
+        a.clock == 0.0 && b.clock == 0.0,
+        "a ball moved before the search"
+    );
     if a.accel != b.accel {
         let time = pair_time(a, b, 0.0, end);
         return (time.unwrap_or(0.0), time.is_some());
