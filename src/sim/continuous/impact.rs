@@ -141,6 +141,17 @@ impl Impact {
         }
     }
 
+    /// An impact that names nothing, for buffers whose every entry is written before it is
+    /// read (the batches that time pairs).
+    pub const UNWRITTEN: Self = Self {
+        time: 0.0,
+        a: 0,
+        other: 0,
+        hits_a: 0,
+        hits_other: 0,
+        indices: (0, 0),
+    };
+
     /// The wall this impact is with, if it is with a wall.
     pub fn wall(&self) -> Option<Wall> {
         (self.other >= WALL_BASE).then(|| Wall::ALL[(self.other - WALL_BASE) as usize])

@@ -314,15 +314,10 @@ struct FirstPairs {
 
 impl FirstPairs {
     fn new() -> Self {
-        let none = Impact::with_wall(
-            0.0,
-            Mover::default().party(0),
-            crate::sim::geometry::Wall::Left,
-        );
         Self {
             pairs: [(0, 0); PAIR_BATCH],
             len: 0,
-            impacts: [none; PAIR_BATCH],
+            impacts: [Impact::UNWRITTEN; PAIR_BATCH],
         }
     }
 

@@ -142,12 +142,7 @@ fn time_found_pairs(
     (now, end): (f64, f64),
     queue: &mut ImpactQueue,
 ) {
-    let none = Impact::with_wall(
-        0.0,
-        Mover::default().party(0),
-        crate::sim::geometry::Wall::Left,
-    );
-    let mut timed = [none; FOUND_BATCH];
+    let mut timed = [Impact::UNWRITTEN; FOUND_BATCH];
     for batch in found.chunks(FOUND_BATCH) {
         let mut kept = 0;
         for &(k, other) in batch {
