@@ -146,6 +146,7 @@ fn time_found_pairs(
     for batch in found.chunks(FOUND_BATCH) {
         let mut kept = 0;
         for &(k, other) in batch {
+            // `k` is 0 or 1: the mask only spares a bounds check.
             let (slot, other) = (slots[usize::from(k & 1)], other as usize);
             let (mover, other_mover) = (&movers[slot], &movers[other]);
             let (time, holds) = pair_time_within(mover, other_mover, now, end);
