@@ -3,7 +3,7 @@
 //! into the grid; their distances cut the candidate pairs, and the exact time of impact gives
 //! each approaching pair's moment of contact within the step, and each ball's first wall
 //! contact. The pairs are timed a batch at a time, without a branch on whether each meets
-//! ([`FirstPairs`]; after an impact, `repredict.rs` times what its search found the same
+//! (`FirstPairs`; after an impact, `repredict.rs` times what its search found the same
 //! way). On one thread the movers are made a row of cells ahead of the pair search, so the
 //! search finds them in the cache; on more, all of them first, in parallel. During the
 //! timeline, a ball redirected by an impact is predicted for again against the balls near the
