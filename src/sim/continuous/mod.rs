@@ -10,7 +10,7 @@
 //!
 //! - stage 2, [`predict_impacts`] ([`predict`]): every approaching pair's and every ball's
 //!   wall time of impact within the step, found through the grid of swept circles
-//!   ([`impact`] holds what a prediction is);
+//!   ([`impact`] holds what a prediction is; `timing.rs` times the pairs, a batch at a time);
 //! - stage 3, [`run_timeline`] ([`timeline`]): the impacts in time order, predicting anew for
 //!   the balls each one redirects (`repredict.rs`; `paths.rs` keeps every ball's current path
 //!   by slot), then every ball to the end of the step, and the balls written back.
@@ -35,6 +35,7 @@ mod queue;
 mod repredict;
 pub mod state;
 pub mod timeline;
+mod timing;
 
 use bevy::prelude::*;
 

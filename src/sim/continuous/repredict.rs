@@ -4,10 +4,11 @@
 //! the cells around both finds both balls' impacts ([`Timeline::predict_for_both`]).
 
 use super::impact::Impact;
-use super::predict::{SWEPT_MARGIN, pair_time, pair_time_within, swept_by, wall_time};
+use super::predict::{SWEPT_MARGIN, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
 use super::state::{Mover, StepSpec, Timeline, Untimed};
+use super::timing::{pair_time, time_found_pairs};
 use crate::sim::geometry::circle::{Circle, within_reach};
 
 impl Timeline {
@@ -127,35 +128,6 @@ fn new_swept(mover: &Mover, now: f64, spec: StepSpec) -> Circle {
     let mut swept = swept_by(mover, spec.dt - now);
     swept.radius += SWEPT_MARGIN;
     swept
-}
-
-/// How many found balls [`time_found_pairs`] times at once.
-const FOUND_BATCH: usize = 16;
-
-/// Queues the impacts of what a search after an impact found, `(k, slot)`: the ball in `slot`
-/// with the ball in `slots[k]`, redirected at `now`, if their paths meet by `end`. What
-/// [`queue_pair_impact`] queues for each, timed a batch at a time without a branch per pair
-/// ([`pair_time_within`]): whether a pair meets is a matter of chance.
-fn time_found_pairs(
-    movers: &[Mover],
-    (found, slots): (&[(u8, u32)], [usize; 2]),
-    (now, end): (f64, f64),
-    queue: &mut ImpactQueue,
-) {
-    let mut timed = [Impact::UNWRITTEN; FOUND_BATCH];
-    for batch in found.chunks(FOUND_BATCH) {
-        let mut kept = 0;
-        for &(k, other) in batch {
-            // `k` is 0 or 1: the mask only spares a bounds check.
-            let (slot, other) = (slots[usize::from(k & 1)], other as usize);
-            let (mover, other_mover) = (&movers[slot], &movers[other]);
-            let (time, holds) = pair_time_within(mover, other_mover, now, end);
-            timed[kept % FOUND_BATCH] =
-                Impact::between(time, mover.party(slot), other_mover.party(other));
-            kept += usize::from(holds & (other != slot));
-        }
-        timed[..kept].iter().for_each(|&impact| queue.push(impact));
-    }
 }
 
 /// Queues the impact of the balls in `slot` and `other`, redirected at `now`, if their paths
