@@ -68,13 +68,10 @@ pub(super) fn pair_time_within(a: &Mover, b: &Mover, now: f64, end: f64) -> (f64
 /// How many of the first search's pairs within reach [`FirstPairs`] times at once.
 const PAIR_BATCH: usize = 64;
 
-/// The first search's pairs within reach, timed a batch at a time. Whether a pair meets
-/// within the step is a matter of chance, so timing each pair as it was found mispredicted a
-/// branch or two a pair, and each pair's square root and division waited for the branches
-/// before them; a batch is timed without a branch per pair ([`approach_time_within`]), each
-/// pair's impact written whether it holds or not and kept if it does. It finds what timing
-/// each pair alone finds (the tests' `predict_pair`), in another order (a batch's impacts
-/// after its overlaps), which the queue's sort undoes; the overlaps keep their order.
+/// The first search's pairs within reach, timed a batch at a time without a branch per pair
+/// ([`approach_time_within`]; the header says why). It finds what timing each pair alone
+/// finds (the tests' `predict_pair`), in another order (a batch's impacts after its
+/// overlaps), which the queue's sort undoes; the overlaps keep their order.
 pub(super) struct FirstPairs {
     pairs: [(u32, u32); PAIR_BATCH],
     len: usize,
@@ -152,9 +149,9 @@ fn first_pair_time_within(a: &Mover, b: &Mover, end: f64) -> (f64, bool) {
 const FOUND_BATCH: usize = 16;
 
 /// Queues the impacts of what a search after an impact found, `(k, slot)`: the ball in `slot`
-/// with the ball in `slots[k]`, redirected at `now`, if their paths meet by `end`. What
-/// [`queue_pair_impact`] queues for each, timed a batch at a time without a branch per pair
-/// ([`pair_time_within`]): whether a pair meets is a matter of chance.
+/// with the ball in `slots[k]`, redirected at `now`, if their paths meet by `end`: what
+/// `repredict.rs`'s `queue_pair_impact` queues for each, timed a batch at a time without a
+/// branch per pair ([`pair_time_within`]).
 pub(super) fn time_found_pairs(
     movers: &[Mover],
     (found, slots): (&[(u8, u32)], [usize; 2]),
