@@ -188,6 +188,14 @@ pub enum Prediction {
     Overlap(u32, u32),
 }
 
+/// The predictions in a fixed order, for the tests that compare two searches.
+#[cfg(test)]
+pub(super) fn sorted(predictions: &[Prediction]) -> Vec<String> {
+    let mut all: Vec<String> = predictions.iter().map(|p| format!("{p:?}")).collect();
+    all.sort();
+    all
+}
+
 #[cfg(test)]
 mod tests {
     use crate::sim::geometry::flight::position_after;

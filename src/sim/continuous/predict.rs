@@ -247,14 +247,8 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    use super::super::impact::sorted;
     use super::*;
-
-    /// The predictions in a fixed order, for comparing two searches.
-    fn sorted(predictions: &[Prediction]) -> Vec<String> {
-        let mut all: Vec<String> = predictions.iter().map(|p| format!("{p:?}")).collect();
-        all.sort();
-        all
-    }
 
     #[test]
     fn searching_around_the_flying_balls_finds_what_every_pair_finds() {

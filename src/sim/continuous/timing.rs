@@ -180,6 +180,7 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    use super::super::impact::sorted;
     use super::super::state::{StepSpec, Timeline};
     use super::*;
 
@@ -212,13 +213,6 @@ mod tests {
                 Impact::between(time, mover_a.party(a as usize), mover_b.party(b as usize));
             found.push(Prediction::Impact(impact));
         }
-    }
-
-    /// The predictions in a fixed order, for comparing two searches.
-    fn sorted(predictions: &[Prediction]) -> Vec<String> {
-        let mut all: Vec<String> = predictions.iter().map(|p| format!("{p:?}")).collect();
-        all.sort();
-        all
     }
 
     #[test]
