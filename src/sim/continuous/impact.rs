@@ -196,6 +196,23 @@ pub(super) fn sorted(predictions: &[Prediction]) -> Vec<String> {
     all
 }
 
+/// `count` circles for the tests, centred at random in the square of half-side `half` about
+/// the origin, of radius in `radii`: each one's x, y and radius drawn from `rng` in turn.
+#[cfg(test)]
+pub(super) fn random_circles(
+    rng: &mut impl rand::RngExt,
+    count: usize,
+    half: f64,
+    radii: std::ops::Range<f64>,
+) -> Vec<Circle> {
+    (0..count)
+        .map(|_| {
+            let center = DVec2::new(rng.random_range(-half..half), rng.random_range(-half..half));
+            Circle::new(center, rng.random_range(radii.clone()))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use crate::sim::geometry::flight::position_after;

@@ -247,21 +247,13 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    use super::super::impact::sorted;
+    use super::super::impact::{random_circles, sorted};
     use super::*;
 
     #[test]
     fn searching_around_the_flying_balls_finds_what_every_pair_finds() {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let circles: Vec<Circle> = (0..400)
-            .map(|_| {
-                let center = DVec2::new(
-                    rng.random_range(-300.0..300.0),
-                    rng.random_range(-300.0..300.0),
-                );
-                Circle::new(center, rng.random_range(3.0..12.0))
-            })
-            .collect();
+        let circles = random_circles(&mut rng, 400, 300.0, 3.0..12.0);
         let held: Vec<bool> = (0..400).map(|k| k % 8 != 0).collect();
         let velocities: Vec<DVec2> = (0..400)
             .map(|_| {

@@ -309,6 +309,8 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    use super::super::impact::random_circles;
+
     use super::*;
     use crate::sim::continuous::predict::swept_by;
 
@@ -339,15 +341,7 @@ mod tests {
         let spec = StepSpec::sixtieth(DVec2::splat(400.0), DVec2::new(30.0, -600.0));
         let mut timeline = Timeline::default();
         for count in [1_500, 3_000, 500, 2_000] {
-            let circles: Vec<Circle> = (0..count)
-                .map(|_| {
-                    let center = DVec2::new(
-                        rng.random_range(-390.0..390.0),
-                        rng.random_range(-390.0..390.0),
-                    );
-                    Circle::new(center, rng.random_range(2.0..6.0))
-                })
-                .collect();
+            let circles = random_circles(&mut rng, count, 390.0, 2.0..6.0);
             let velocities: Vec<DVec2> = (0..count)
                 .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * 400.0)
                 .collect();

@@ -180,7 +180,7 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    use super::super::impact::sorted;
+    use super::super::impact::{random_circles, sorted};
     use super::super::state::{StepSpec, Timeline};
     use super::*;
 
@@ -272,15 +272,7 @@ mod tests {
         // under gravity (a still ball and a flying one accelerate differently).
         let mut rng = ChaCha8Rng::seed_from_u64(29);
         let count = 3_000;
-        let circles: Vec<Circle> = (0..count)
-            .map(|_| {
-                let center = DVec2::new(
-                    rng.random_range(-300.0..300.0),
-                    rng.random_range(-300.0..300.0),
-                );
-                Circle::new(center, rng.random_range(3.0..9.0))
-            })
-            .collect();
+        let circles = random_circles(&mut rng, count, 300.0, 3.0..9.0);
         let velocities: Vec<DVec2> = (0..count)
             .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * rng.random_range(0.0..900.0))
             .collect();
