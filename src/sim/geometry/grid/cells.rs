@@ -14,7 +14,12 @@ const MAX_CELLS_PER_BALL: usize = 4;
 pub struct CellMap {
     origin: DVec2,
     inverse_cell_size: f64,
+    /// `1 / inverse_cell_size`, worked out once: a query's reach reads it for every ball an
+    /// impact redirects.
+    cell_size: f64,
     pub columns: usize,
+    /// Divides a cell's number by `columns` without a division instruction.
+    by_columns: Divisor,
     pub rows: usize,
     /// Whether the cap on cells left the rectangle's last columns or rows to share the border
     /// cells (see [`cell_index`](Self::cell_index)).
@@ -40,10 +45,13 @@ impl CellMap {
         );
         let columns = columns_needed.min(max_cells);
         let rows = rows_needed.min((max_cells / columns).max(1));
+        let inverse_cell_size = 1.0 / cell_size;
         Self {
             origin: min,
-            inverse_cell_size: 1.0 / cell_size,
+            inverse_cell_size,
+            cell_size: 1.0 / inverse_cell_size,
             columns,
+            by_columns: Divisor::new(columns as u32),
             rows,
             capped: columns < columns_needed || rows < rows_needed,
         }
@@ -57,14 +65,23 @@ impl CellMap {
 
     /// The side of a cell.
     pub fn cell_size(&self) -> f64 {
-        1.0 / self.inverse_cell_size
+        self.cell_size
+    }
+
+    /// `(row, column)` of cell `cell`, one of this map's.
+    #[inline]
+    pub fn row_and_column(&self, cell: usize) -> (usize, usize) {
+        debug_assert!(cell < self.cell_count(), "cell {cell} past the map");
+        let (row, column) = self.by_columns.quotient_and_remainder(cell as u32);
+        (row as usize, column as usize)
     }
 
     /// How far, along either axis, `point` lies outside cell `cell` (zero inside), with a
     /// margin against rounding: a box around `point` grown by this reaches the cell.
     pub fn distance_to_cell(&self, cell: usize, point: DVec2) -> f64 {
         let size = self.cell_size();
-        let corner = DVec2::new((cell % self.columns) as f64, (cell / self.columns) as f64);
+        let (row, column) = self.row_and_column(cell);
+        let corner = DVec2::new(column as f64, row as f64);
         let low = self.origin + corner * size;
         let outside = (low - point).max(point - (low + size)).max(DVec2::ZERO);
         let margin = 1e-9 * (size + point.abs().max_element() + self.origin.abs().max_element());
@@ -103,6 +120,40 @@ impl CellMap {
         let column = (cell.x as u32 as usize).min(self.columns - 1);
         let row = (cell.y as u32 as usize).min(self.rows - 1);
         (column, row)
+    }
+}
+
+/// Division by a `u32` fixed in advance, through a multiplication: the quotient and remainder
+/// of any `u32` (D. Lemire, O. Kaser, N. Kurz, *Faster remainder by direct computation*,
+/// 2019: a 64-bit reciprocal is exact for 32-bit numerators). A division instruction takes a
+/// dozen cycles or more, on the path of every query that starts from a ball's cell.
+#[derive(Clone, Copy, Debug, Default)]
+struct Divisor {
+    divisor: u32,
+    /// `ceil(2^64 / divisor)`, or 0 for a divisor of 1 (which would need 2^64).
+    reciprocal: u64,
+}
+
+impl Divisor {
+    /// Dividing by `divisor`, at least 1.
+    fn new(divisor: u32) -> Self {
+        assert!(divisor > 0, "a division by zero");
+        Self {
+            divisor,
+            reciprocal: (u64::MAX / u64::from(divisor)).wrapping_add(1),
+        }
+    }
+
+    /// `(n / divisor, n % divisor)`.
+    #[inline]
+    fn quotient_and_remainder(self, n: u32) -> (u32, u32) {
+        if self.divisor == 1 {
+            return (n, 0);
+        }
+        let quotient = (u128::from(self.reciprocal) * u128::from(n)) >> 64;
+        let fraction = self.reciprocal.wrapping_mul(u64::from(n));
+        let remainder = (u128::from(fraction) * u128::from(self.divisor)) >> 64;
+        (quotient as u32, remainder as u32)
     }
 }
 
@@ -155,6 +206,45 @@ mod tests {
             line.cell_coordinates(DVec2::new(1e300, 0.0)).0,
             u32::MAX as usize - 1
         );
+    }
+
+    #[test]
+    fn dividing_through_the_reciprocal_gives_what_division_gives() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut divisors = vec![1, 2, 3, 5, 7, 10, 64, 641, 1 << 16, 65_537, u32::MAX - 1];
+        divisors.extend([u32::MAX, (1 << 31) + 1, 1 << 31]);
+        divisors.extend((0..200).map(|_| rng.random_range(1..=u32::MAX)));
+        divisors.extend((0..200).map(|_| rng.random_range(1..5_000)));
+        for divisor in divisors {
+            let by = Divisor::new(divisor);
+            let mut numerators = vec![0, 1, divisor - 1, divisor, u32::MAX, u32::MAX - 1];
+            numerators.extend(divisor.checked_mul(3).map(|n| n - 1));
+            numerators.extend((0..500).map(|_| rng.random_range(0..=u32::MAX)));
+            for n in numerators {
+                let expected = (n / divisor, n % divisor);
+                assert_eq!(by.quotient_and_remainder(n), expected, "{n} / {divisor}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_cell_s_row_and_column_are_its_number_s_quotient_and_remainder() {
+        let map = CellMap::covering(DVec2::splat(-100.0), DVec2::new(230.0, 90.0), 3.0, 10_000);
+        assert!(map.columns > 1 && map.rows > 1 && map.columns != map.rows);
+        for cell in 0..map.cell_count() {
+            assert_eq!(
+                map.row_and_column(cell),
+                (cell / map.columns, cell % map.columns)
+            );
+        }
+        assert_eq!(
+            map.cell_size().to_bits(),
+            (1.0 / map.inverse_cell_size).to_bits()
+        );
+        let column = CellMap::covering(DVec2::ZERO, DVec2::new(1.0, 100.0), 1.0, 100);
+        assert_eq!(column.columns, 1);
+        assert_eq!(column.row_and_column(column.rows - 1), (column.rows - 1, 0));
     }
 
     #[test]

@@ -185,13 +185,12 @@ impl UniformGrid {
     /// The row and column of the cell of the ball in `slot`: none for a big ball, or a slot past
     /// the last.
     fn cell_in_row_and_column(&self, slot: usize) -> Option<(usize, usize)> {
-        let columns = self.cells.columns;
         let cell = self
             .cell_of
             .get(slot)
             .copied()
             .filter(|&cell| cell != NO_CELL)?;
-        Some((cell as usize / columns, cell as usize % columns))
+        Some(self.cells.row_and_column(cell as usize))
     }
 
     /// The balls in the cells that overlap the box `[min, max]`.
