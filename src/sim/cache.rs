@@ -48,3 +48,51 @@ pub fn prefetch_whole<T: bytemuck::Pod>(place: Option<&T>) {
     prefetch(place);
     prefetch(place.and_then(|place| bytemuck::bytes_of(place).last()));
 }
+
+/// The size of a cache line on the machines this runs on (x86-64 and most ARM).
+const LINE: usize = 64;
+
+/// [`prefetch`] for every cache line that `values` spans, each once: a prefetch for each
+/// value, or every other one, asks again for lines already on their way, and at a million
+/// balls the prefetches themselves wait for room among the misses in flight.
+#[inline(always)]
+pub fn prefetch_lines<T: bytemuck::Pod>(values: &[T]) {
+    let bytes: &[u8] = bytemuck::cast_slice(values);
+    for offset in one_byte_a_line(bytes.as_ptr() as usize, bytes.len()) {
+        prefetch(bytes.get(offset));
+    }
+}
+
+/// Where, in `len` bytes from `address`, one byte of each cache line they span lies: the first
+/// byte, then the first of each line after it.
+#[inline(always)]
+fn one_byte_a_line(address: usize, len: usize) -> impl Iterator<Item = usize> {
+    let next_line = LINE - address % LINE;
+    let first = (len > 0).then_some(0);
+    first.into_iter().chain((next_line..len).step_by(LINE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_line_a_run_of_bytes_spans_is_loaded_once() {
+        for address in [0, 1, 8, 40, 63, 64, 100, 4096 + 24] {
+            for len in 0..300 {
+                let lines: Vec<usize> = one_byte_a_line(address, len)
+                    .map(|offset| {
+                        assert!(offset < len, "{offset} past {len} bytes");
+                        (address + offset) / LINE
+                    })
+                    .collect();
+                let spanned: Vec<usize> = if len == 0 {
+                    Vec::new()
+                } else {
+                    (address / LINE..=(address + len - 1) / LINE).collect()
+                };
+                assert_eq!(lines, spanned, "{len} bytes from {address}");
+            }
+        }
+    }
+}

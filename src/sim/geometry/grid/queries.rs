@@ -10,7 +10,7 @@ use bevy::math::DVec2;
 
 use super::counting::NO_CELL;
 use super::uniform::UniformGrid;
-use crate::sim::cache::prefetch;
+use crate::sim::cache::{prefetch, prefetch_lines};
 use crate::sim::geometry::circle::Circle;
 
 /// From this many balls the loads ahead of a query cover four rows of four cells, every cache
@@ -129,10 +129,8 @@ impl UniformGrid {
     #[inline(never)]
     fn load_wide_cells_around(&self, slot: usize) {
         for cells in self.wide_cell_runs_around(slot) {
-            let slots = self.slots_of(cells);
-            // Every other circle of 24 B, and the last, falls in each of the run's lines.
-            for slot in slots.clone().step_by(2).chain(slots.end.checked_sub(1)) {
-                prefetch(self.sorted_circle.get(slot));
+            if let Some(circles) = self.sorted_circle.get(self.slots_of(cells)) {
+                prefetch_lines(circles);
             }
         }
     }
