@@ -30,7 +30,10 @@ impl ImpactQueue {
     pub fn start(&mut self, impacts: impl Iterator<Item = Impact> + Clone, horizon: f64) {
         // The buckets' count only sets how the sort splits its work, never the order: an upper
         // bound on the impacts will do, and spares a pass over them (6.5 MB at a million).
-        let count = (impacts.size_hint().1).unwrap_or_else(|| impacts.clone().count());
+        let count = impacts
+            .size_hint()
+            .1
+            .unwrap_or_else(|| impacts.clone().count());
         let buckets = TimeBuckets::over(horizon, count / IMPACTS_PER_SORTED_BUCKET);
         sort_in_buckets(impacts, buckets, (&mut self.sorted, &mut self.bucket_ends));
         self.next = 0;
