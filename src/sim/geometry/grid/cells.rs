@@ -51,6 +51,7 @@ impl CellMap {
             inverse_cell_size,
             cell_size: 1.0 / inverse_cell_size,
             columns,
+            // At most `u32::MAX` columns (`max_cells`), and at least one.
             by_columns: Divisor::new(columns as u32),
             rows,
             capped: columns < columns_needed || rows < rows_needed,
