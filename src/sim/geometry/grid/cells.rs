@@ -165,6 +165,9 @@ fn cells_along(extent: f64, cell_size: f64) -> usize {
 
 #[cfg(test)]
 mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
     use super::*;
 
     #[test]
@@ -211,8 +214,7 @@ mod tests {
 
     #[test]
     fn dividing_through_the_reciprocal_gives_what_division_gives() {
-        use rand::{RngExt, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
         let mut divisors = vec![1, 2, 3, 5, 7, 10, 64, 641, 1 << 16, 65_537, u32::MAX - 1];
         divisors.extend([u32::MAX, (1 << 31) + 1, 1 << 31]);
         divisors.extend((0..200).map(|_| rng.random_range(1..=u32::MAX)));
