@@ -103,11 +103,13 @@ impl Timeline {
 /// ahead was 0.4–1.5% slower there, and the same at 100,000 (64 ahead no better than 32).
 pub(super) const INPUTS_AHEAD: usize = 32;
 
-/// Loads what the collision stage was given for the ball in `slot` (its circle, velocity and
-/// whether it is held), for many balls: the movers are made in the grid's slot order, which
-/// reads the inputs by each ball's index, scattered in memory. At 100,000 balls that pass
-/// spent most of its time waiting for those reads (docs/performance.md, *The inputs loaded
-/// ahead of the movers*).
+/// Loads what the collision stage was given for the ball in `slot` (its circle, both lines of
+/// it when it straddles two, as a quarter of them do; its velocity and whether it is held),
+/// for many balls: the movers are made in the grid's slot order, which reads the inputs by
+/// each ball's index, scattered in memory. At 100,000 balls that pass spent most of its time
+/// waiting for those reads (docs/performance.md, *The inputs loaded ahead of the movers*);
+/// the circle's second line took another 0.8–1% off at 100,000 balls and a million (the
+/// fortieth session).
 pub(super) fn prefetch_inputs(
     (circles, velocities, held): (&[Circle], &[DVec2], &[bool]),
     order: &[u32],
@@ -120,7 +122,7 @@ pub(super) fn prefetch_inputs(
         return;
     };
     let ball = ball as usize;
-    prefetch(circles.get(ball));
+    prefetch_whole(circles.get(ball));
     prefetch(velocities.get(ball));
     prefetch(held.get(ball));
 }
