@@ -315,6 +315,31 @@ mod tests {
     use crate::sim::continuous::predict::swept_by;
 
     #[test]
+    fn a_step_ends_with_every_flying_ball_unstopped_whatever_the_flags_came_in_as() {
+        // The end of the step writes a flying ball's flags only when some ball was held, and
+        // otherwise clears `stopped` first: flags that come in dirty must leave clean, with
+        // none held and with one.
+        let spec = StepSpec::sixtieth(DVec2::splat(300.0), DVec2::ZERO);
+        for held_first in [false, true] {
+            let mut rng = ChaCha8Rng::seed_from_u64(21);
+            let mut circles = random_circles(&mut rng, 1000, 290.0, 3.0..8.0);
+            let mut velocities: Vec<DVec2> = (0..1000)
+                .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * 900.0)
+                .collect();
+            let (mut held, mut stopped) = (vec![false; 1000], vec![true; 1000]);
+            held[0] = held_first;
+            let mut timeline = Timeline::default();
+            timeline.predict(&circles, &velocities, &held, spec);
+            let mut hits = 0;
+            let flags = (&mut held[..], &mut stopped[..]);
+            timeline.run(&mut circles, &mut velocities, flags, spec, |_| hits += 1);
+            assert!(hits > 100, "{hits} hits");
+            assert!(!stopped.contains(&true), "held first: {held_first}");
+            assert!(!held[1..].contains(&true));
+        }
+    }
+
+    #[test]
     fn a_mover_names_its_ball_by_its_index_whether_it_holds_still_or_flies() {
         let circle = Circle::new(DVec2::ZERO, 1.0);
         let last = MAX_BALLS as u32 - 1;

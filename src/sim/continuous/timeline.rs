@@ -317,7 +317,8 @@ impl Timeline {
     }
 
     /// Every ball where the end of the step finds it. A held ball stays held if nothing hit
-    /// it; a ball still now that was not held all along stopped against a held one.
+    /// it; a ball still now that was not held all along stopped against a held one. With none
+    /// held (a gas), only the balls still now have their flags written, `stopped` cleared first.
     fn move_to_the_end(
         &mut self,
         circles: &mut [Circle],
@@ -333,6 +334,10 @@ impl Timeline {
                 movers.iter_mut().for_each(|mover| mover.advance(spec.dt));
             });
         }
+        let none_held = !held.contains(&true);
+        if none_held {
+            stopped.fill(false);
+        }
         let mut inside = true;
         for (&ball, mover) in self.order.iter().zip(&self.movers) {
             let index = ball as usize;
@@ -342,8 +347,10 @@ impl Timeline {
                 mover.state_at(spec.dt)
             };
             (circles[index].center, velocities[index]) = (center, velocity);
-            held[index] &= mover.is_still() && mover.hits == 0;
-            stopped[index] = mover.is_still() && !held[index];
+            if mover.is_still() || !none_held {
+                held[index] &= mover.is_still() && mover.hits == 0;
+                stopped[index] = mover.is_still() && !held[index];
+            }
             inside &= lies_inside(center, mover.radius, spec.half);
         }
         self.ends_inside = inside;
