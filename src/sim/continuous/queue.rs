@@ -3,10 +3,9 @@
 //! (after an impact redirects a ball) fall into buckets by time, as in a calendar queue: only
 //! the impacts of the buckets the timeline has reached are in a heap, which stays small (17
 //! impacts on average, at 100,000 balls as at a million), and each later bucket's is a plain
-//! list until the timeline reaches it. Taking the
-//! earlier of the two heads gives the order one heap of them all would give. The first
-//! predictions are sorted the same way: spread over buckets of time, a few to a bucket, and
-//! each bucket sorted.
+//! list until the timeline reaches it. Taking the earlier of the two heads gives the order one
+//! heap of them all would give. The first predictions are sorted the same way: spread over
+//! buckets of time, a few to a bucket, and each bucket sorted.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
