@@ -57,12 +57,15 @@ impl ImpactQueue {
         self.sorted.get(self.next + distance)
     }
 
-    /// The earliest impact predicted during the step: it may be taken next.
+    /// The earliest impact predicted during the step in the buckets the timeline has reached:
+    /// it may be taken next.
     pub fn earliest_later(&self) -> Option<&Impact> {
         self.later.earliest()
     }
 
-    /// Whether an impact left comes before `impact` (in [`Impact`]'s order).
+    /// Whether an impact left comes before `impact` (in [`Impact`]'s order), the last one
+    /// [`pop`](Self::pop) took: that pop reached its bucket, so an impact waiting in a later
+    /// bucket's list comes after it, and only the two heads need be asked.
     pub fn has_before(&self, impact: &Impact) -> bool {
         self.sorted
             .get(self.next)
