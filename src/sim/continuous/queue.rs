@@ -328,7 +328,7 @@ mod tests {
             let mut heap: BinaryHeap<Reverse<Impact>> =
                 first.iter().copied().map(Reverse).collect();
             let (mut taken, mut expected) = (Vec::new(), Vec::new());
-            let (mut most_waiting, mut ahead_of_a_push) = (0, 0);
+            let (mut most_waiting, mut pops_with_lists_waiting) = (0, 0);
             for round in 0..6000 {
                 // Now and then an impact predicted during the step: mostly at or after the
                 // last taken, a few before it (a bucket already passed) or past the horizon.
@@ -354,7 +354,7 @@ mod tests {
                         reached <= queue.later.bucket_of(first.time),
                         "round {round}"
                     );
-                    ahead_of_a_push += usize::from(
+                    pops_with_lists_waiting += usize::from(
                         queue.later.lists[reached + 1..]
                             .iter()
                             .any(|list| !list.is_empty()),
@@ -368,9 +368,9 @@ mod tests {
             assert_eq!(taken, expected, "horizon {horizon}");
             // Many of those pops left impacts waiting in later buckets, unless all fell in one.
             assert_eq!(
-                ahead_of_a_push > 300,
+                pops_with_lists_waiting > 300,
                 horizon > 0.0,
-                "{ahead_of_a_push} pops with lists waiting"
+                "{pops_with_lists_waiting} pops with impacts waiting in later lists"
             );
             // The lists held impacts waiting for their bucket, unless there was one bucket.
             assert_eq!(buckets, 3000 / IMPACTS_PER_BUCKET);
