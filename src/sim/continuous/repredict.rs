@@ -8,7 +8,7 @@ use super::predict::{SWEPT_MARGIN, swept_by, wall_time};
 use super::prefetch::prefetch_mover;
 use super::queue::ImpactQueue;
 use super::state::{Mover, StepSpec, Timeline, Untimed};
-use super::timing::{pair_time, time_found_pairs};
+use super::timing::pair_time;
 use crate::sim::geometry::circle::{Circle, within_reach};
 
 impl Timeline {
@@ -71,7 +71,7 @@ impl Timeline {
             .for_each_that_may_touch_any(&self.grid, swept, hits_of, |k, other| {
                 if other as usize != a && other as usize != b {
                     prefetch_mover(movers, other);
-                    found.push((k as u8, other));
+                    found.push(k as u8, other);
                 }
             });
         self.take_new_path(a, swept[0], now, spec);
@@ -97,7 +97,7 @@ impl Timeline {
             return;
         };
         let (balls, queue) = (self.movers.as_slice(), &mut self.queue);
-        time_found_pairs(balls, (&self.found, [a, b]), (now, end), queue);
+        self.found.time_all(balls, [a, b], (now, end), queue);
         if b_finds_a {
             queue_pair_impact(balls, (b, a), now, end, queue);
         }

@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use super::impact::{Impact, Party, Prediction};
 use super::paths::Paths;
 use super::queue::ImpactQueue;
+use super::timing::FoundBalls;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::circle::RadiusRange;
 use crate::sim::geometry::flight::{position_after, velocity_after};
@@ -254,9 +255,9 @@ pub struct Timeline {
     pub(super) paths: Paths,
     /// Contacts for the discrete response of a step cut short.
     pub(super) fallback: FoundInBands<IndexedContact>,
-    /// The balls the search after an impact found, `(which of its two balls, slot)`, before
-    /// each is timed (`Timeline::predict_for_both`, `Timeline::time_what_was_found`).
-    pub(super) found: Vec<(u8, u32)>,
+    /// The balls the search after an impact found, before each is timed
+    /// (`Timeline::predict_for_both`, `Timeline::time_what_was_found`).
+    pub(super) found: FoundBalls,
     /// The impact whose found balls are still to be timed (`Timeline::time_what_was_found`).
     pub(super) untimed: Option<Untimed>,
     /// How many of the step's first predictions had been taken when the loads ahead last

@@ -1,6 +1,6 @@
 //! When two balls on the continuous timeline meet: [`pair_time`] for one pair, and the same
 //! time worked out whole for pairs timed a batch at a time, the step's first search's
-//! ([`FirstPairs`]) and what a search after an impact found ([`time_found_pairs`]). Whether a
+//! ([`FirstPairs`]) and what a search after an impact found ([`FoundBalls`]). Whether a
 //! pair meets within the step is a matter of chance, so timing each pair as it was found
 //! mispredicted a branch or two a pair, and each pair's square root and division waited for
 //! the branches before them; a batch is timed without a branch per pair, each pair's impact
@@ -145,32 +145,63 @@ fn first_pair_time_within(a: &Mover, b: &Mover, end: f64) -> (f64, bool) {
     approach_time_within((a.circle(), velocity_a), (b.circle(), velocity_b), end)
 }
 
-/// How many found balls [`time_found_pairs`] times at once.
+/// How many found balls [`FoundBalls::time_all`] times at once.
 const FOUND_BATCH: usize = 16;
 
-/// Queues the impacts of what a search after an impact found, `(k, slot)`: the ball in `slot`
-/// with the ball in `slots[k]`, redirected at `now`, if their paths meet by `end`: what
-/// `repredict.rs`'s `queue_pair_impact` queues for each, timed a batch at a time without a
-/// branch per pair ([`pair_time_within`]).
-pub(super) fn time_found_pairs(
-    movers: &[Mover],
-    (found, slots): (&[(u8, u32)], [usize; 2]),
-    (now, end): (f64, f64),
-    queue: &mut ImpactQueue,
-) {
-    let mut timed = [Impact::UNWRITTEN; FOUND_BATCH];
-    for batch in found.chunks(FOUND_BATCH) {
-        let mut kept = 0;
-        for &(k, other) in batch {
-            // `k` is 0 or 1: the mask only spares a bounds check.
-            let (slot, other) = (slots[usize::from(k & 1)], other as usize);
-            let (mover, other_mover) = (&movers[slot], &movers[other]);
-            let (time, holds) = pair_time_within(mover, other_mover, now, end);
-            timed[kept % FOUND_BATCH] =
-                Impact::between(time, mover.party(slot), other_mover.party(other));
-            kept += usize::from(holds & (other != slot));
+/// What a search after an impact found, `(k, slot)`: the ball in `slot` near the new path of
+/// the impact's ball `k` (0 or 1), listed as found and timed later
+/// ([`time_all`](Self::time_all)). The batch the times are written to is kept from one impact
+/// to the next: made afresh for each, its 512 B were cleared at every collision.
+#[derive(Debug)]
+pub(super) struct FoundBalls {
+    listed: Vec<(u8, u32)>,
+    timed: [Impact; FOUND_BATCH],
+}
+
+impl Default for FoundBalls {
+    fn default() -> Self {
+        Self {
+            listed: Vec::new(),
+            timed: [Impact::UNWRITTEN; FOUND_BATCH],
         }
-        timed[..kept].iter().for_each(|&impact| queue.push(impact));
+    }
+}
+
+impl FoundBalls {
+    /// Nothing found yet: a new search.
+    pub(super) fn clear(&mut self) {
+        self.listed.clear();
+    }
+
+    /// The ball in `slot` was found near the new path of the impact's ball `k`.
+    pub(super) fn push(&mut self, k: u8, slot: u32) {
+        self.listed.push((k, slot));
+    }
+
+    /// Queues the impact of each ball found with the ball in `slots[k]`, redirected at `now`,
+    /// if their paths meet by `end`: what `repredict.rs`'s `queue_pair_impact` queues for
+    /// each, timed a batch at a time without a branch per pair ([`pair_time_within`]).
+    pub(super) fn time_all(
+        &mut self,
+        movers: &[Mover],
+        slots: [usize; 2],
+        (now, end): (f64, f64),
+        queue: &mut ImpactQueue,
+    ) {
+        let timed = &mut self.timed;
+        for batch in self.listed.chunks(FOUND_BATCH) {
+            let mut kept = 0;
+            for &(k, other) in batch {
+                // `k` is 0 or 1: the mask only spares a bounds check.
+                let (slot, other) = (slots[usize::from(k & 1)], other as usize);
+                let (mover, other_mover) = (&movers[slot], &movers[other]);
+                let (time, holds) = pair_time_within(mover, other_mover, now, end);
+                timed[kept % FOUND_BATCH] =
+                    Impact::between(time, mover.party(slot), other_mover.party(other));
+                kept += usize::from(holds & (other != slot));
+            }
+            timed[..kept].iter().for_each(|&impact| queue.push(impact));
+        }
     }
 }
 
