@@ -327,6 +327,13 @@ mod tests {
             let mut velocities: Vec<DVec2> = (0..1000)
                 .map(|_| DVec2::from_angle(rng.random_range(0.0..6.3)) * 900.0)
                 .collect();
+            // The balls near the first head for it.
+            for k in 1..1000 {
+                let towards = circles[0].center - circles[k].center;
+                if towards.length() < 40.0 {
+                    velocities[k] = towards.normalize() * 900.0;
+                }
+            }
             let (mut held, mut stopped) = (vec![false; 1000], vec![true; 1000]);
             held[0] = held_first;
             let mut timeline = Timeline::default();
@@ -337,6 +344,11 @@ mod tests {
             assert!(hits > 100, "{hits} hits");
             assert!(!stopped.contains(&true), "held first: {held_first}");
             assert!(!held[1..].contains(&true));
+            // The first ball is hit: held, it was set flying, and is no longer held.
+            let mut hits_by_index = Vec::new();
+            timeline.hits_by_index(&mut hits_by_index);
+            assert!(hits_by_index[0] > 0, "{} hits", hits_by_index[0]);
+            assert!(!held[0]);
         }
     }
 

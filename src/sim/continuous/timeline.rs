@@ -334,7 +334,9 @@ impl Timeline {
                 movers.iter_mut().for_each(|mover| mover.advance(spec.dt));
             });
         }
-        let none_held = !held.contains(&true);
+        // Every flag read, without stopping at the first held one: LLVM then reads them 16
+        // at a time (`contains` reads one at a time, and in a gas none is held).
+        let none_held = !held.iter().fold(false, |any, &held| any | held);
         if none_held {
             stopped.fill(false);
         }
