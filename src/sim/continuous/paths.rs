@@ -11,7 +11,7 @@
 use bevy::math::DVec2;
 
 use crate::sim::geometry::Circle;
-use crate::sim::geometry::circle::{Probes, within_reach};
+use crate::sim::geometry::circle::within_reach;
 use crate::sim::geometry::grid::UniformGrid;
 
 /// How far each ball's current path reaches, and the paths kept apart. The current paths of
@@ -122,7 +122,7 @@ impl Paths {
             let slots = grid.slots_of(cells);
             let first = slots.start;
             for (offset, &circle) in current[slots].iter().enumerate() {
-                visit_touched_by(&probes, circle, (first + offset) as u32, &mut visit);
+                probes.visit_touched_by(circle, (first + offset) as u32, &mut visit);
             }
         });
         // Big balls on their first path, through their own grid; then the paths kept apart.
@@ -135,26 +135,46 @@ impl Paths {
         }
         for path in &self.far {
             if hits_of(path.slot) == path.hits {
-                visit_touched_by(&probes, path.swept, path.slot, &mut visit);
+                probes.visit_touched_by(path.swept, path.slot, &mut visit);
             }
         }
     }
 }
 
-/// Calls `visit(k, slot)` for each of the circles `probes` holds that `circle`, the current
-/// path of the ball in `slot`, touches by [`within_reach`].
-#[inline]
-fn visit_touched_by<const N: usize>(
-    probes: &Probes<N>,
-    circle: Circle,
-    slot: u32,
-    visit: &mut impl FnMut(usize, u32),
-) {
-    let reached = probes.reached_by(circle);
-    if reached != 0 {
+/// The circles a search looks around, coordinate by coordinate, so that a candidate is
+/// tested against all of them at once: a collision's two new paths take one operation a
+/// step of the test, each in one lane of the processor's two-double registers.
+struct Probes<const N: usize> {
+    x: [f64; N],
+    y: [f64; N],
+    radius: [f64; N],
+}
+
+impl<const N: usize> Probes<N> {
+    fn new(swept: &[Circle; N]) -> Self {
+        Self {
+            x: swept.map(|probe| probe.center.x),
+            y: swept.map(|probe| probe.center.y),
+            radius: swept.map(|probe| probe.radius),
+        }
+    }
+
+    /// Calls `visit(k, slot)` for each of the circles `swept[k]` that `circle`, the current
+    /// path of the ball in `slot`, touches by [`within_reach`] (the same sums and products,
+    /// so the same answer to the bit).
+    #[inline]
+    fn visit_touched_by(&self, circle: Circle, slot: u32, visit: &mut impl FnMut(usize, u32)) {
+        let mut touched = 0_u32;
         for k in 0..N {
-            if reached >> k & 1 != 0 {
-                visit(k, slot);
+            let (dx, dy) = (circle.center.x - self.x[k], circle.center.y - self.y[k]);
+            let reach = self.radius[k] + circle.radius;
+            touched |= u32::from(dx * dx + dy * dy <= reach * reach) << k;
+        }
+        if touched != 0 {
+            for k in 0..N {
+                if touched >> k & 1 != 0 {
+                    visit(k, slot);
+                }
             }
         }
     }
@@ -175,6 +195,49 @@ mod tests {
         );
         slots.sort_unstable();
         slots
+    }
+
+    #[test]
+    fn probes_find_what_within_reach_finds_to_the_bit() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let random_circle = |rng: &mut rand_chacha::ChaCha8Rng| {
+            let center = DVec2::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0));
+            Circle::new(center, rng.random_range(0.5..20.0))
+        };
+        let (mut touching, mut edge) = (0, 0);
+        for case in 0..20_000 {
+            let swept = [random_circle(&mut rng), random_circle(&mut rng)];
+            let mut circle = match case % 4 {
+                0 => NOWHERE,
+                _ => random_circle(&mut rng),
+            };
+            if case % 4 == 1 {
+                // Exactly the sum of the radii apart along an axis: the test's very edge.
+                circle.center = swept[1].center + DVec2::X * (swept[1].radius + circle.radius);
+                edge += usize::from(within_reach(swept[1], circle));
+            }
+            let expected: Vec<(usize, u32)> = (0..2)
+                .filter(|&k| within_reach(swept[k], circle))
+                .map(|k| (k, 7))
+                .collect();
+            let mut visited = Vec::new();
+            Probes::new(&swept).visit_touched_by(circle, 7, &mut |k, slot| visited.push((k, slot)));
+            assert_eq!(visited, expected, "case {case}");
+            let mut alone = Vec::new();
+            Probes::new(&[swept[1]])
+                .visit_touched_by(circle, 7, &mut |k, slot| alone.push((k, slot)));
+            assert_eq!(
+                alone.len(),
+                usize::from(within_reach(swept[1], circle)),
+                "case {case}"
+            );
+            touching += visited.len();
+        }
+        assert!(
+            touching > 2_000 && edge > 1_000,
+            "{touching} touching, {edge} at the edge"
+        );
     }
 
     /// `circles` in a grid numbered by slot (with the slot order) and every ball on its first

@@ -166,38 +166,6 @@ pub fn within_reach(a: Circle, b: Circle) -> bool {
     (b.center - a.center).length_squared() <= reach * reach
 }
 
-/// Circles laid out coordinate by coordinate, so that another circle is tested against all
-/// of them at once ([`reached_by`](Self::reached_by)): for two, LLVM makes each step of the
-/// test one operation on both, one in each lane of the processor's two-double registers.
-pub struct Probes<const N: usize> {
-    x: [f64; N],
-    y: [f64; N],
-    radius: [f64; N],
-}
-
-impl<const N: usize> Probes<N> {
-    pub fn new(probes: &[Circle; N]) -> Self {
-        Self {
-            x: probes.map(|probe| probe.center.x),
-            y: probes.map(|probe| probe.center.y),
-            radius: probes.map(|probe| probe.radius),
-        }
-    }
-
-    /// Bit `k` set if [`within_reach`]`(probes[k], circle)`: the same sums and products, so
-    /// the same answer to the bit.
-    #[inline]
-    pub fn reached_by(&self, circle: Circle) -> u32 {
-        let mut reached = 0_u32;
-        for k in 0..N {
-            let (dx, dy) = (circle.center.x - self.x[k], circle.center.y - self.y[k]);
-            let reach = self.radius[k] + circle.radius;
-            reached |= u32::from(dx * dx + dy * dy <= reach * reach) << k;
-        }
-        reached
-    }
-}
-
 /// The exact test: AABB first, then squared distance against `(r1 + r2)^2` (no square root
 /// unless the circles really touch). Returns `None` for circles that neither touch nor overlap.
 #[inline]
@@ -424,47 +392,5 @@ mod tests {
         assert_eq!((all.smallest, all.largest), (1.0, 5.5));
         // A NaN changes nothing.
         assert_eq!(all.with(f64::NAN), all);
-    }
-
-    #[test]
-    fn probes_find_what_within_reach_finds_to_the_bit() {
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let random_circle = |rng: &mut ChaCha8Rng| {
-            let center = DVec2::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0));
-            Circle::new(center, rng.random_range(0.5..20.0))
-        };
-        let nowhere = Circle::new(DVec2::splat(f64::NAN), f64::NAN);
-        let (mut reached, mut edge) = (0, 0);
-        for case in 0..20_000 {
-            let probes = [random_circle(&mut rng), random_circle(&mut rng)];
-            let mut circle = match case % 4 {
-                0 => nowhere,
-                _ => random_circle(&mut rng),
-            };
-            if case % 4 == 1 {
-                // Exactly the sum of the radii apart along an axis: the test's very edge.
-                circle.center = probes[1].center + DVec2::X * (probes[1].radius + circle.radius);
-                edge += usize::from(within_reach(probes[1], circle));
-            }
-            let expected = (0..2)
-                .map(|k| u32::from(within_reach(probes[k], circle)) << k)
-                .sum::<u32>();
-            assert_eq!(
-                Probes::new(&probes).reached_by(circle),
-                expected,
-                "case {case}"
-            );
-            let alone = u32::from(within_reach(probes[1], circle));
-            assert_eq!(
-                Probes::new(&[probes[1]]).reached_by(circle),
-                alone,
-                "case {case}"
-            );
-            reached += expected.count_ones();
-        }
-        assert!(
-            reached > 2_000 && edge > 1_000,
-            "{reached} reached, {edge} at the edge"
-        );
     }
 }

@@ -6,13 +6,12 @@
 //! first, writing every candidate's slot and keeping it only if it touches, leaves one loop
 //! whose branches are predictable and a short one over the few that touch. The test is the
 //! caller's: the narrow phase's `circles_touch` (AABB, then distance), or the distance alone
-//! (`within_reach`) for the continuous mode's swept circles, where two balls of a cell are
-//! tested together against the candidates they share, in two lanes ([`TwoBalls`]).
+//! (`within_reach`) for the continuous mode's swept circles.
 
 use std::ops::Range;
 
 use super::uniform::UniformGrid;
-use crate::sim::geometry::circle::{Circle, Probes, circles_touch, within_reach};
+use crate::sim::geometry::circle::{Circle, circles_touch, within_reach};
 
 /// How many touching slots the buffer holds: candidates are tested half as many at a time, so
 /// that what a chunk finds fits beside what the chunks before it found, until they are
@@ -86,81 +85,6 @@ impl TouchingRuns {
     }
 }
 
-/// The balls of one cell (`balls`, slots) and their candidates: for the ball in `slot`, the
-/// rest of its cell and the cell to its right (`slot + 1..same_row_end`), then the run of
-/// three cells above (`above`).
-struct CellCandidates {
-    balls: Range<usize>,
-    same_row_end: usize,
-    above: Range<usize>,
-}
-
-impl CellCandidates {
-    /// How many candidates the balls in `slot` and `slot + 1` share: all of the second's.
-    fn shared_by_two(&self, slot: usize) -> usize {
-        self.same_row_end - (slot + 2) + self.above.len()
-    }
-}
-
-/// Two balls of a cell tested together against the candidates they share, each candidate
-/// against both at once ([`Probes`]): one pass over the candidates where there were two, and
-/// each test a step of two lanes. What each ball finds is kept apart, to be visited in the
-/// order the balls one at a time visit it: the first ball's pairs (the second ball first),
-/// then the second's. For at most [`RUN`] shared candidates, which the buffers hold.
-struct TwoBalls {
-    first: [u32; RUN],
-    second: [u32; RUN],
-}
-
-impl TwoBalls {
-    fn new() -> Self {
-        Self {
-            first: [0; RUN],
-            second: [0; RUN],
-        }
-    }
-
-    /// Calls `visit` for the pairs within reach ([`within_reach`]) of the balls in `slot` and
-    /// `slot + 1` of `cell`, as two calls of `UniformGrid::visit_ball_pairs` would, in the
-    /// same order.
-    #[inline]
-    fn visit_pairs(
-        &mut self,
-        grid: &UniformGrid,
-        slot: usize,
-        cell: &CellCandidates,
-        visit: &mut impl FnMut(u32, u32, Circle, Circle),
-    ) {
-        debug_assert!(cell.shared_by_two(slot) <= RUN);
-        let (circles, indices) = (&grid.sorted_circle, &grid.sorted_index);
-        let (a, b) = (circles[slot], circles[slot + 1]);
-        let probes = Probes::new(&[a, b]);
-        let (mut found_a, mut found_b) = (0, 0);
-        for range in [slot + 2..cell.same_row_end, cell.above.clone()] {
-            for (other, &circle) in range.clone().zip(&circles[range]) {
-                let reached = probes.reached_by(circle);
-                // Found are fewer than `RUN` here: the modulo only tells the compiler so.
-                self.first[found_a % RUN] = other as u32;
-                found_a += (reached & 1) as usize;
-                self.second[found_b % RUN] = other as u32;
-                found_b += (reached >> 1) as usize;
-            }
-        }
-        let (index_a, index_b) = (indices[slot], indices[slot + 1]);
-        if within_reach(a, b) {
-            visit(index_a, index_b, a, b);
-        }
-        for &other in &self.first[..found_a] {
-            let other = other as usize;
-            visit(index_a, indices[other], a, circles[other]);
-        }
-        for &other in &self.second[..found_b] {
-            let other = other as usize;
-            visit(index_b, indices[other], b, circles[other]);
-        }
-    }
-}
-
 impl UniformGrid {
     /// Calls `visit(i, j, circle_i, circle_j)` once for every pair of balls whose circles
     /// touch: the candidates, pairs in the same or adjacent cells and pairs with a big ball
@@ -185,28 +109,13 @@ impl UniformGrid {
 
     /// [`for_each_touching_pair_in_rows`](Self::for_each_touching_pair_in_rows) with the
     /// squared-distance test alone ([`within_reach`]), for bounding circles: the pairs it
-    /// visits, and those tangent to the last bit that the AABB test turns away. In the same
-    /// order, but two balls of a cell are tested together against the candidates they share
-    /// (`TwoBalls`).
+    /// visits, and those tangent to the last bit that the AABB test turns away.
     pub fn for_each_pair_within_reach_in_rows(
         &self,
         rows: std::ops::Range<usize>,
-        mut visit: impl FnMut(u32, u32, Circle, Circle),
+        visit: impl FnMut(u32, u32, Circle, Circle),
     ) {
-        let (mut runs, mut two) = (TouchingRuns::new(), TwoBalls::new());
-        let each_cell = |runs: &mut TouchingRuns, cell: CellCandidates, visit: &mut _| {
-            let mut slot = cell.balls.start;
-            while slot < cell.balls.end {
-                if slot + 1 < cell.balls.end && cell.shared_by_two(slot) <= RUN {
-                    two.visit_pairs(self, slot, &cell, visit);
-                    slot += 2;
-                } else {
-                    self.visit_ball_pairs(slot, &cell, (runs, within_reach), visit);
-                    slot += 1;
-                }
-            }
-        };
-        self.for_each_cell_in_rows(rows, (&mut runs, within_reach), &mut visit, each_cell);
+        self.for_each_pair_in_rows_by(rows, within_reach, visit);
     }
 
     /// The pairs of `rows` whose circles pass `touch`, in the order of
@@ -217,34 +126,16 @@ impl UniformGrid {
         touch: impl Fn(Circle, Circle) -> bool + Copy,
         mut visit: impl FnMut(u32, u32, Circle, Circle),
     ) {
-        let mut runs = TouchingRuns::new();
-        let each_cell = |runs: &mut TouchingRuns, cell: CellCandidates, visit: &mut _| {
-            for slot in cell.balls.clone() {
-                self.visit_ball_pairs(slot, &cell, (runs, touch), visit);
-            }
-        };
-        self.for_each_cell_in_rows(rows, (&mut runs, touch), &mut visit, each_cell);
-    }
-
-    /// Calls `each_cell` with every cell of `rows` that holds a ball and its candidates, row
-    /// by row, the big balls' pairs (by `touch`) with the first row and each row's big balls
-    /// with its small ones after it.
-    fn for_each_cell_in_rows<V: FnMut(u32, u32, Circle, Circle)>(
-        &self,
-        rows: std::ops::Range<usize>,
-        (runs, touch): (&mut TouchingRuns, impl Fn(Circle, Circle) -> bool + Copy),
-        visit: &mut V,
-        mut each_cell: impl FnMut(&mut TouchingRuns, CellCandidates, &mut V),
-    ) {
         // With the band that holds the first row (a band may be empty: more bands than rows).
         if rows.contains(&0) {
-            self.visit_big_pairs(touch, visit);
+            self.visit_big_pairs(touch, &mut visit);
         }
         // In row-major order a cell and its right neighbour are adjacent, and the three cells
         // above (left, centre, right) are one contiguous run: each ball's candidates are two
         // contiguous slot ranges, the rest of its own cell with the right cell, and the run
         // above, each tested without a branch per candidate.
         let columns = self.cells.columns;
+        let mut runs = TouchingRuns::new();
         for row in rows {
             for column in 0..columns {
                 let cell = row * columns + column;
@@ -264,39 +155,24 @@ impl UniformGrid {
                 } else {
                     0..0
                 };
-                let balls = start..end;
-                let candidates = CellCandidates {
-                    balls,
-                    same_row_end,
-                    above,
-                };
-                each_cell(runs, candidates, visit);
+                for slot in start..end {
+                    let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
+                    let ranges = [slot + 1..same_row_end, above.clone()];
+                    let probe = (circle, touch);
+                    runs.for_each_touching_in(probe, ranges, &self.sorted_circle, |other| {
+                        visit(
+                            index,
+                            self.sorted_index[other],
+                            circle,
+                            self.sorted_circle[other],
+                        );
+                    });
+                }
             }
             if self.big_grid().is_some() {
-                self.visit_big_with_small_in_row(row, (runs, touch), visit);
+                self.visit_big_with_small_in_row(row, (&mut runs, touch), &mut visit);
             }
         }
-    }
-
-    /// The pairs of the ball in `slot`, of `cell`, with its candidates that pass `touch`.
-    #[inline]
-    fn visit_ball_pairs(
-        &self,
-        slot: usize,
-        cell: &CellCandidates,
-        (runs, touch): (&mut TouchingRuns, impl Fn(Circle, Circle) -> bool),
-        visit: &mut impl FnMut(u32, u32, Circle, Circle),
-    ) {
-        let (index, circle) = (self.sorted_index[slot], self.sorted_circle[slot]);
-        let ranges = [slot + 1..cell.same_row_end, cell.above.clone()];
-        runs.for_each_touching_in((circle, touch), ranges, &self.sorted_circle, |other| {
-            visit(
-                index,
-                self.sorted_index[other],
-                circle,
-                self.sorted_circle[other],
-            );
-        });
     }
 
     /// The pairs of two big balls that pass `touch`, through their own grid.
@@ -416,35 +292,6 @@ mod tests {
             }
             assert_eq!(joined, all, "{bands} bands");
         }
-    }
-
-    #[test]
-    fn two_balls_at_a_time_visit_what_one_at_a_time_visits_in_its_order() {
-        // Mixed sizes (big balls apart), a row of tangent pairs, and 50 small balls in one
-        // cell: more candidates than the buffers hold, so its first balls go one at a time.
-        let mut circles = mixed_sizes();
-        circles.extend((0..40).map(|k| Circle::new(DVec2::new(k as f64 * 1.1, -30.0), 0.55)));
-        circles.extend((0..50).map(|k| {
-            let place = DVec2::new((k % 7) as f64, (k / 7) as f64) * 0.1;
-            Circle::new(DVec2::new(300.0, 300.0) + place, 1.0)
-        }));
-        let mut grid = UniformGrid::default();
-        grid.rebuild(&circles);
-        let rows = grid.rows();
-        let (mut two_at_a_time, mut one_at_a_time) = (Vec::new(), Vec::new());
-        grid.for_each_pair_within_reach_in_rows(0..rows, |i, j, a, b| {
-            two_at_a_time.push((i, j, a, b));
-        });
-        grid.for_each_pair_in_rows_by(0..rows, within_reach, |i, j, a, b| {
-            one_at_a_time.push((i, j, a, b));
-        });
-        assert_eq!(two_at_a_time, one_at_a_time);
-        // The cluster's pairs all touch: 50 * 49 / 2 of them.
-        assert!(
-            one_at_a_time.len() > 1_225 + 300,
-            "{} pairs",
-            one_at_a_time.len()
-        );
     }
 
     #[test]
