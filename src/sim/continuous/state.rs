@@ -344,7 +344,7 @@ mod tests {
             assert!(hits > 100, "{hits} hits");
             assert!(!stopped.contains(&true), "held first: {held_first}");
             assert!(!held[1..].contains(&true));
-            // The first ball is hit: held, it was set flying, and is no longer held.
+            // The first ball is hit and ends not held: if it came in held, the hit set it flying.
             let mut hits_by_index = Vec::new();
             timeline.hits_by_index(&mut hits_by_index);
             assert!(hits_by_index[0] > 0, "{} hits", hits_by_index[0]);
