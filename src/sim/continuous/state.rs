@@ -10,7 +10,6 @@ use bevy::prelude::*;
 use super::impact::{Impact, Party, Prediction};
 use super::paths::Paths;
 use super::queue::ImpactQueue;
-use super::timing::FoundBalls;
 use crate::sim::geometry::Circle;
 use crate::sim::geometry::circle::RadiusRange;
 use crate::sim::geometry::flight::{position_after, velocity_after};
@@ -230,6 +229,41 @@ pub(super) struct Untimed {
     pub now: f64,
     pub a_finds_b: bool,
     pub b_finds_a: bool,
+}
+
+/// How many found balls [`FoundBalls::time_all`] (`timing.rs`) times at once.
+pub(super) const FOUND_BATCH: usize = 16;
+
+/// What a search after an impact found, `(k, slot)`: the ball in `slot` near the new path of
+/// the impact's ball `k` (0 or 1), listed as found and timed later
+/// ([`time_all`](Self::time_all), in `timing.rs`). The batch the times are written to is
+/// kept from one impact to the next: made afresh for each, its 512 B were cleared at every
+/// collision.
+#[derive(Debug)]
+pub(super) struct FoundBalls {
+    pub(super) listed: Vec<(u8, u32)>,
+    pub(super) timed: [Impact; FOUND_BATCH],
+}
+
+impl Default for FoundBalls {
+    fn default() -> Self {
+        Self {
+            listed: Vec::new(),
+            timed: [Impact::UNWRITTEN; FOUND_BATCH],
+        }
+    }
+}
+
+impl FoundBalls {
+    /// Nothing found yet: a new search.
+    pub(super) fn clear(&mut self) {
+        self.listed.clear();
+    }
+
+    /// The ball in `slot` was found near the new path of the impact's ball `k`.
+    pub(super) fn push(&mut self, k: u8, slot: u32) {
+        self.listed.push((k, slot));
+    }
 }
 
 /// The continuous mode's working state, kept between steps to reuse its buffers.

@@ -384,9 +384,8 @@ impl Timeline {
         );
     }
 
-    /// Pushes apart, shared by inverse mass, the pairs that overlapped at the start of the
-    /// step and still do; a held ball does not move, and two held ones are the resting
-    /// stage's.
+    /// Pushes apart, shared by inverse mass, the pairs that overlapped at the start of the step
+    /// and still do; a held ball does not move, and two held ones are the resting stage's.
     fn push_apart_overlaps(&self, circles: &mut [Circle], held: &[bool], spec: StepSpec) {
         for &(a, b) in &self.overlapping {
             let (a, b) = (a as usize, b as usize);
@@ -412,8 +411,7 @@ impl Timeline {
 /// Ball `mover`, at a wall and closing slower than the resting speed, stops against it: its
 /// velocity into the wall goes, and so does gravity's push into it for the rest of the step,
 /// so it slides along the wall. Returns the impulse per unit mass the wall gives it over the
-/// step (the stop and the push it carries), or `None` if it neither moves nor is pushed into
-/// the wall.
+/// step (the stop and the push it carries), or `None` if it neither moves nor is pushed.
 fn stop_against_wall(mover: &mut Mover, wall: Wall, spec: StepSpec, now: f64) -> Option<f64> {
     let outward = wall.outward_normal();
     let (speed_in, pushed_in) = (

@@ -13,7 +13,7 @@
 
 use super::impact::{Impact, Prediction, approach_time, approach_time_within};
 use super::queue::ImpactQueue;
-use super::state::Mover;
+use super::state::{FOUND_BATCH, FoundBalls, Mover};
 use crate::sim::geometry::circle::{Circle, overlapping};
 use crate::sim::geometry::flight::time_to_touch;
 
@@ -145,39 +145,7 @@ fn first_pair_time_within(a: &Mover, b: &Mover, end: f64) -> (f64, bool) {
     approach_time_within((a.circle(), velocity_a), (b.circle(), velocity_b), end)
 }
 
-/// How many found balls [`FoundBalls::time_all`] times at once.
-const FOUND_BATCH: usize = 16;
-
-/// What a search after an impact found, `(k, slot)`: the ball in `slot` near the new path of
-/// the impact's ball `k` (0 or 1), listed as found and timed later
-/// ([`time_all`](Self::time_all)). The batch the times are written to is kept from one impact
-/// to the next: made afresh for each, its 512 B were cleared at every collision.
-#[derive(Debug)]
-pub(super) struct FoundBalls {
-    listed: Vec<(u8, u32)>,
-    timed: [Impact; FOUND_BATCH],
-}
-
-impl Default for FoundBalls {
-    fn default() -> Self {
-        Self {
-            listed: Vec::new(),
-            timed: [Impact::UNWRITTEN; FOUND_BATCH],
-        }
-    }
-}
-
 impl FoundBalls {
-    /// Nothing found yet: a new search.
-    pub(super) fn clear(&mut self) {
-        self.listed.clear();
-    }
-
-    /// The ball in `slot` was found near the new path of the impact's ball `k`.
-    pub(super) fn push(&mut self, k: u8, slot: u32) {
-        self.listed.push((k, slot));
-    }
-
     /// Queues the impact of each ball found with the ball in `slots[k]`, redirected at `now`,
     /// if their paths meet by `end`: what `repredict.rs`'s `queue_pair_impact` queues for
     /// each, timed a batch at a time without a branch per pair ([`pair_time_within`]).
