@@ -79,7 +79,8 @@ impl Paths {
         self.far.push(FarPath { slot, hits, swept });
     }
 
-    /// Ball `slot` takes no more impacts this step: no path of it is found any more.
+    /// Ball `slot`'s current path is over: no path of it is found any more, until it takes a
+    /// new one ([`redirect`](Self::redirect)) if it has hits left this step.
     pub fn end(&mut self, grid: &mut UniformGrid, slot: u32) {
         if (slot as usize) < grid.small_count() {
             grid.replace_circle_in_slot(slot as usize, NOWHERE);

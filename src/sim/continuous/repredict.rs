@@ -61,6 +61,11 @@ impl Timeline {
         let a_finds_b =
             b < self.grid.small_count() && within_reach(swept[0], self.grid.circle_in_slot(b));
         let b_finds_a = within_reach(swept[1], swept[0]);
+        // Their paths until now taken out of the grid, where the search would find them
+        // (they pass through the impact's point, which both new paths start from) only to
+        // skip them: each such find a branch the other way, about two a collision.
+        self.paths.end(&mut self.grid, a as u32);
+        self.paths.end(&mut self.grid, b as u32);
         // It skips both balls, so it finds what it would after their new paths are filed:
         // every other ball's path lies within the reach of the paths so far.
         let movers = &self.movers;
