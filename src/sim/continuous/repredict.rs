@@ -63,21 +63,21 @@ impl Timeline {
         let b_finds_a = within_reach(swept[1], swept[0]);
         // Their paths until now taken out of the grid, where the search would find them
         // (they pass through the impact's point, which both new paths start from) only to
-        // skip them: each such find a branch the other way, about two a collision.
+        // skip them: each such find a branch the other way, about two a collision. Neither
+        // is found then (a big ball's first path, or one kept apart, is stale by its hits),
+        // so it finds what it would after their new paths are filed: every other ball's path
+        // lies within the reach of the paths so far.
         self.paths.end(&mut self.grid, a as u32);
         self.paths.end(&mut self.grid, b as u32);
-        // It skips both balls, so it finds what it would after their new paths are filed:
-        // every other ball's path lies within the reach of the paths so far.
         let movers = &self.movers;
         let hits_of = |other: u32| movers[other as usize].hits;
         let found = &mut self.found;
         found.clear();
         self.paths
             .for_each_that_may_touch_any(&self.grid, swept, hits_of, |k, other| {
-                if other as usize != a && other as usize != b {
-                    prefetch_mover(movers, other);
-                    found.push(k as u8, other);
-                }
+                debug_assert!(other as usize != a && other as usize != b);
+                prefetch_mover(movers, other);
+                found.push(k as u8, other);
             });
         self.take_new_path(a, swept[0], now, spec);
         self.take_new_path(b, swept[1], now, spec);
